@@ -1,0 +1,143 @@
+#include "common/process/process.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+
+#include "common/time/utime.h"
+#include "vimot/heartbeat_t.hpp"
+
+namespace vimot {
+
+namespace {
+std::atomic<bool> g_signal_received{false};
+
+void on_signal(int) { g_signal_received = true; }
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+// Decode errors are logged for the first few, then only counted, so a
+// stream of garbage cannot flood the log.
+constexpr int64_t kMaxDecodeErrorsLogged = 10;
+}  // namespace
+
+Process::Process(std::string name, std::string summary, bool config_required)
+    : name_(std::move(name)), config_required_(config_required), args_(name_, std::move(summary)) {
+  args_.add_option("lcm-url", "URL", "LCM provider URL (default: $LCM_DEFAULT_URL, else LCM's default)");
+  args_.add_option("config", "FILE", config_required ? "YAML configuration (required)" : "YAML configuration");
+  args_.add_option("log-level", "LEVEL", "debug, info, warn or error", "info");
+}
+
+Process::~Process() = default;
+
+bool Process::init(int argc, const char* const* argv) {
+  if (!args_.parse(argc, argv)) return false;
+  set_log_name(name_);
+  set_log_level(parse_log_level(args_.get("log-level")));
+  if (args_.given("config")) {
+    config_ = Config::load_file(args_.get("config"));
+  } else if (config_required_) {
+    throw ArgError(name_ + ": --config FILE is required (see --help)");
+  }
+  const std::string url = args_.get("lcm-url");
+  lcm_ = std::make_unique<lcm::LCM>(url);
+  if (!lcm_->good()) {
+    throw std::runtime_error(name_ + ": cannot open LCM" + (url.empty() ? std::string() : " at '" + url + "'"));
+  }
+  install_signal_handlers();
+  log_info("started (pid ", getpid(), ")");
+  return true;
+}
+
+std::string Process::channel(const std::string& role, const std::string& fallback) const {
+  return config_.get_or<std::string>("channels." + role, fallback);
+}
+
+void Process::handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                         const std::function<bool(const void*, int)>& decode_and_call) {
+  ++counters_.messages_in;
+  bool decoded = false;
+  try {
+    decoded = decode_and_call(rbuf->data, static_cast<int>(rbuf->data_size));
+  } catch (const std::exception& e) {
+    report_error("handling " + channel + ": " + e.what());
+    return;
+  }
+  if (!decoded) {
+    ++counters_.decode_errors;
+    if (++decode_errors_logged_ <= kMaxDecodeErrorsLogged) {
+      log_warn("cannot decode a ", rbuf->data_size, "-byte message on ", channel,
+               " (wrong type or corrupt); dropped",
+               decode_errors_logged_ == kMaxDecodeErrorsLogged ? " — further decode errors only counted" : "");
+    }
+  }
+}
+
+void Process::report_error(const std::string& what) {
+  ++counters_.errors;
+  last_error_ = what;
+  log_error(what);
+}
+
+void Process::report_dropped(const std::string& why) {
+  ++counters_.dropped;
+  log_warn("dropped: ", why);
+}
+
+bool Process::stop_requested() const { return stop_requested_ || g_signal_received; }
+
+void Process::publish_heartbeat() {
+  heartbeat_t hb;
+  hb.utime = wall_clock_utime();  // monitoring only, never used for estimation
+  hb.name = name_;
+  hb.pid = static_cast<int32_t>(getpid());
+  hb.messages_in = counters_.messages_in;
+  hb.messages_out = counters_.messages_out;
+  hb.decode_errors = counters_.decode_errors;
+  hb.dropped = counters_.dropped;
+  hb.errors = counters_.errors;
+  hb.status = counters_.errors > 0 ? "degraded" : "ok";
+  hb.last_error = last_error_;
+  lcm_->publish(config_.get_or<std::string>("channels.heartbeat", "HEARTBEAT"), &hb);
+}
+
+int Process::run(const std::function<void()>& idle) {
+  using Clock = std::chrono::steady_clock;
+  auto next_heartbeat = Clock::now();
+  while (!stop_requested()) {
+    const int status = lcm_->handleTimeout(100);
+    if (status < 0) {
+      report_error("LCM handle failed");
+      return 1;
+    }
+    if (idle) idle();
+    if (Clock::now() >= next_heartbeat) {
+      publish_heartbeat();
+      next_heartbeat += std::chrono::seconds(1);
+    }
+  }
+  log_info("stopping: in ", counters_.messages_in.load(), ", out ", counters_.messages_out.load(),
+           ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(),
+           ", errors ", counters_.errors.load());
+  return 0;
+}
+
+int run_process_main(const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << std::endl;
+    return 1;
+  }
+}
+
+}  // namespace vimot

@@ -1,0 +1,138 @@
+#pragma once
+// The scaffold every vimot process stands on (pronto/libbot2 shape):
+//   parse arguments -> load and validate config -> build handlers ->
+//   subscribe -> loop on handle() until SIGINT/SIGTERM.
+// It owns the LCM handle, the 1 Hz HEARTBEAT (counters: messages in/out,
+// decode errors, dropped, errors) and the typed subscribe/publish wrappers
+// that turn a malformed message or a throwing handler into a counted,
+// logged error instead of a crash. The algorithm never sees this class.
+//
+// Common options: --lcm-url URL (default: $LCM_DEFAULT_URL, else LCM's
+// default), --config FILE, --log-level LEVEL, --help.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "common/config/config.h"
+#include "common/process/arg_parser.h"
+#include "common/process/logger.h"
+
+namespace vimot {
+
+struct ProcessCounters {
+  std::atomic<int64_t> messages_in{0};
+  std::atomic<int64_t> messages_out{0};
+  std::atomic<int64_t> decode_errors{0};
+  std::atomic<int64_t> dropped{0};
+  std::atomic<int64_t> errors{0};
+};
+
+class Process {
+ public:
+  /// `config_required`: --config must be given (a process with no sensible
+  /// defaults); otherwise an absent --config gives an empty Config.
+  Process(std::string name, std::string summary, bool config_required = false);
+  ~Process();
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  /// Declare process-specific options here before init().
+  ArgParser& args() { return args_; }
+
+  /// Parses arguments, loads the config, opens LCM, installs the signal
+  /// handlers. Returns false when the process should exit 0 (--help).
+  /// Throws ArgError / ConfigError / std::runtime_error on bad input.
+  bool init(int argc, const char* const* argv);
+
+  const std::string& name() const { return name_; }
+  const Config& config() const { return config_; }
+  lcm::LCM& lcm() { return *lcm_; }
+  ProcessCounters& counters() { return counters_; }
+
+  /// A channel name from config key `channels.<role>`, `fallback` if absent.
+  std::string channel(const std::string& role, const std::string& fallback) const;
+
+  /// Subscribes with decoding done here, so a malformed message is counted
+  /// as a decode error and logged (rate-limited), never a crash.
+  template <typename Msg>
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler);
+
+  template <typename Msg>
+  void publish(const std::string& channel, const Msg& msg) {
+    if (lcm_->publish(channel, &msg) == 0) {
+      ++counters_.messages_out;
+    } else {
+      report_error("publish on " + channel + " failed");
+    }
+  }
+
+  /// Logs and counts an error; the last one is carried by the heartbeat.
+  void report_error(const std::string& what);
+  /// Counts dropped input (late, duplicate, out-of-order) with a reason.
+  void report_dropped(const std::string& why);
+
+  /// Handles LCM until stop() or a signal; sends a heartbeat every second.
+  /// `idle` runs after each handled batch or timeout (e.g. deferred work).
+  int run(const std::function<void()>& idle = {});
+  void stop() { stop_requested_ = true; }
+  bool stop_requested() const;
+
+  /// Publishes one heartbeat now (also called by run() at 1 Hz).
+  void publish_heartbeat();
+
+ private:
+  void handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                  const std::function<bool(const void*, int)>& decode_and_call);
+
+  std::string name_;
+  bool config_required_{false};
+  ArgParser args_;
+  Config config_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  ProcessCounters counters_;
+  std::string last_error_;
+  int64_t decode_errors_logged_{0};
+  std::atomic<bool> stop_requested_{false};
+
+  // Subscriptions keep their closures alive for the LCM callbacks.
+  struct RawSubscription {
+    Process* owner;
+    std::string channel;
+    std::function<bool(const void*, int)> decode_and_call;
+  };
+  std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
+};
+
+template <typename Msg>
+void Process::subscribe(const std::string& channel, std::function<void(const Msg&)> handler) {
+  auto sub = std::make_unique<RawSubscription>();
+  sub->owner = this;
+  sub->channel = channel;
+  sub->decode_and_call = [handler = std::move(handler)](const void* data, int size) {
+    Msg msg;
+    if (msg.decode(data, 0, size) != size) return false;
+    handler(msg);
+    return true;
+  };
+  RawSubscription* raw = sub.get();
+  subscriptions_.push_back(std::move(sub));
+  lcm_->subscribeFunction(
+      channel,
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string& chan, RawSubscription* s) {
+        s->owner->handle_raw(rbuf, chan, s->decode_and_call);
+      },
+      raw);
+}
+
+/// Runs a process main, turning any escaping exception into a one-line error
+/// and exit code 1 (bad arguments and configs are the common case).
+int run_process_main(const std::function<int()>& body);
+
+}  // namespace vimot
