@@ -65,12 +65,17 @@ class Config {
 
   const std::string& source() const { return source_; }
 
+  /// The key's full dotted path from the file's root ("cameras.cam0.T_BS").
+  std::string full_key(const std::string& key) const;
+
+  /// Throws ConfigError "config '<file>': key '<full key>' <what>", for
+  /// checks a caller makes beyond type and presence.
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
  private:
   Config(YAML::Node root, std::string source, std::string prefix);
   YAML::Node find(const std::string& key) const;       // undefined node if absent
   YAML::Node require(const std::string& key) const;    // throws if absent
-  std::string full_key(const std::string& key) const;
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
 
   YAML::Node root_;
   std::string source_;
