@@ -117,8 +117,14 @@ void Process::subscribe(const std::string& channel, std::function<void(const Msg
   sub->channel = channel;
   sub->decode_and_call = [handler = std::move(handler)](const void* data, int size) {
     Msg msg;
-    if (msg.decode(data, 0, size) != size) return false;
-    handler(msg);
+    // lcm-gen 1.3 decoders throw (length_error, bad_alloc) on a corrupt array
+    // length instead of returning < 0: both are a malformed message.
+    try {
+      if (msg.decode(data, 0, size) != size) return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+    handler(msg);  // exceptions here are the handler's: counted as errors
     return true;
   };
   RawSubscription* raw = sub.get();

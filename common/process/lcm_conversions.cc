@@ -1,0 +1,130 @@
+#include "common/process/lcm_conversions.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace vimot {
+
+namespace {
+
+template <int N>
+Eigen::Matrix<double, N, 1> read(const double (&a)[N], const char* what, int64_t utime) {
+  Eigen::Matrix<double, N, 1> v;
+  for (int i = 0; i < N; ++i) {
+    if (!std::isfinite(a[i])) {
+      throw std::invalid_argument(std::string(what) + " has a non-finite value at utime " + std::to_string(utime));
+    }
+    v(i) = a[i];
+  }
+  return v;
+}
+
+template <int N>
+void write(const Eigen::Matrix<double, N, 1>& v, double (&a)[N]) {
+  for (int i = 0; i < N; ++i) a[i] = v(i);
+}
+
+}  // namespace
+
+imu_t to_lcm(const ImuData& imu) {
+  imu_t msg{};
+  msg.utime = imu.utime;
+  write<3>(imu.w_IinI, msg.angular_velocity);
+  write<3>(imu.a_IinI, msg.linear_acceleration);
+  return msg;
+}
+
+ImuData from_lcm(const imu_t& msg) {
+  ImuData imu;
+  imu.utime = msg.utime;
+  imu.w_IinI = read<3>(msg.angular_velocity, "imu_t.angular_velocity", msg.utime);
+  imu.a_IinI = read<3>(msg.linear_acceleration, "imu_t.linear_acceleration", msg.utime);
+  return imu;
+}
+
+features_t to_lcm(const CameraFrame& frame) {
+  features_t msg{};
+  msg.utime = frame.utime;
+  msg.num_obs = static_cast<int32_t>(frame.observations.size());
+  msg.obs.reserve(frame.observations.size());
+  for (const FeatureObservation& o : frame.observations) {
+    feature_obs_t m{};
+    m.feature_id = o.feature_id;
+    m.camera_id = static_cast<int8_t>(o.camera_id);
+    m.u = o.pixel.x();
+    m.v = o.pixel.y();
+    m.x_norm = o.normalized.x();
+    m.y_norm = o.normalized.y();
+    m.is_target = o.is_target;
+    msg.obs.push_back(m);
+  }
+  return msg;
+}
+
+CameraFrame from_lcm(const features_t& msg) {
+  if (msg.num_obs < 0 || static_cast<std::size_t>(msg.num_obs) != msg.obs.size()) {
+    throw std::invalid_argument("features_t: num_obs " + std::to_string(msg.num_obs) + " does not match " +
+                                std::to_string(msg.obs.size()) + " observations");
+  }
+  CameraFrame frame;
+  frame.utime = msg.utime;
+  frame.observations.reserve(msg.obs.size());
+  for (const feature_obs_t& m : msg.obs) {
+    if (!std::isfinite(m.u) || !std::isfinite(m.v) || !std::isfinite(m.x_norm) || !std::isfinite(m.y_norm)) {
+      throw std::invalid_argument("features_t: feature " + std::to_string(m.feature_id) +
+                                  " has non-finite coordinates at utime " + std::to_string(msg.utime));
+    }
+    if (m.camera_id < 0) {
+      throw std::invalid_argument("features_t: negative camera_id " + std::to_string(m.camera_id));
+    }
+    FeatureObservation o;
+    o.feature_id = m.feature_id;
+    o.camera_id = m.camera_id;
+    o.pixel = Eigen::Vector2d(m.u, m.v);
+    o.normalized = Eigen::Vector2d(m.x_norm, m.y_norm);
+    o.is_target = m.is_target;
+    frame.observations.push_back(o);
+  }
+  return frame;
+}
+
+ground_truth_t to_lcm(const GroundTruth& t) {
+  ground_truth_t msg{};
+  msg.utime = t.utime;
+  write<4>(t.q_GtoI, msg.q_GtoI);
+  write<3>(t.p_IinG, msg.p_IinG);
+  write<3>(t.v_IinG, msg.v_IinG);
+  write<3>(t.w_IinI, msg.w_IinI);
+  write<3>(t.a_IinG, msg.a_IinG);
+  write<3>(t.bias_gyro, msg.bias_gyro);
+  write<3>(t.bias_accel, msg.bias_accel);
+  msg.target_valid = t.has_target;
+  write<4>(t.q_GtoT, msg.q_GtoT);
+  write<3>(t.p_TinG, msg.p_TinG);
+  write<3>(t.v_TinT, msg.v_TinT);
+  write<3>(t.w_TinT, msg.w_TinT);
+  return msg;
+}
+
+GroundTruth from_lcm(const ground_truth_t& msg) {
+  GroundTruth t;
+  t.utime = msg.utime;
+  t.q_GtoI = read<4>(msg.q_GtoI, "ground_truth_t.q_GtoI", msg.utime);
+  t.p_IinG = read<3>(msg.p_IinG, "ground_truth_t.p_IinG", msg.utime);
+  t.v_IinG = read<3>(msg.v_IinG, "ground_truth_t.v_IinG", msg.utime);
+  t.w_IinI = read<3>(msg.w_IinI, "ground_truth_t.w_IinI", msg.utime);
+  t.a_IinG = read<3>(msg.a_IinG, "ground_truth_t.a_IinG", msg.utime);
+  t.bias_gyro = read<3>(msg.bias_gyro, "ground_truth_t.bias_gyro", msg.utime);
+  t.bias_accel = read<3>(msg.bias_accel, "ground_truth_t.bias_accel", msg.utime);
+  t.has_target = msg.target_valid;
+  if (t.has_target) {
+    t.q_GtoT = read<4>(msg.q_GtoT, "ground_truth_t.q_GtoT", msg.utime);
+    t.p_TinG = read<3>(msg.p_TinG, "ground_truth_t.p_TinG", msg.utime);
+    t.v_TinT = read<3>(msg.v_TinT, "ground_truth_t.v_TinT", msg.utime);
+    t.w_TinT = read<3>(msg.w_TinT, "ground_truth_t.w_TinT", msg.utime);
+  }
+  return t;
+}
+
+}  // namespace vimot

@@ -1,0 +1,24 @@
+#pragma once
+// The one place where LCM messages become plain vimot types and back, so the
+// algorithms never see an LCM type. from_lcm() checks what a message could
+// get wrong (non-finite numbers, bad counts, camera ids) and throws
+// std::invalid_argument saying what; the scaffold counts it as an error.
+
+#include "common/types/ground_truth.h"
+#include "common/types/sensor_data.h"
+#include "vimot/features_t.hpp"
+#include "vimot/ground_truth_t.hpp"
+#include "vimot/imu_t.hpp"
+
+namespace vimot {
+
+imu_t to_lcm(const ImuData& imu);
+ImuData from_lcm(const imu_t& msg);
+
+features_t to_lcm(const CameraFrame& frame);
+CameraFrame from_lcm(const features_t& msg);
+
+ground_truth_t to_lcm(const GroundTruth& truth);
+GroundTruth from_lcm(const ground_truth_t& msg);
+
+}  // namespace vimot

@@ -1,0 +1,219 @@
+// vimot-sheriff: headless procman sheriff for this machine. See --help and
+// docs/sheriff.md.
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "procs/sheriff/sheriff.h"
+#include "procs/sheriff/sheriff_config_parser.h"
+
+namespace {
+
+using vimot::sheriff::Sheriff;
+using vimot::sheriff::SheriffOptions;
+
+// Exit status for a bad command line or config, distinct from the 1 of "a
+// managed command failed".
+constexpr int kUsageError = 2;
+
+constexpr char kUsage[] = R"(usage: vimot-sheriff [options] CONFIG.pmd
+
+Headless procman sheriff: starts the commands of a libbot2 procman config on
+this machine, prints their output as "[name] line", respawns auto_respawn
+commands, and on Ctrl-C / SIGTERM stops everything in reverse start order
+(a second Ctrl-C kills what is left).
+
+options:
+  --script NAME     run script NAME instead of starting every command
+  --group NAME      start only group NAME and its subgroups ("a/b" = nested)
+  --exit-when CMD   when CMD ends (exits and is not respawned, or exits with
+                    code 0), stop everything else and exit with CMD's status
+  --duration SEC    stop everything after SEC seconds (decimals allowed)
+  --list            print the config's groups, commands and scripts and exit
+  -h, --help        print this help
+
+config format (libbot2 procman, '#' starts a comment):
+  group "0.sensors" {                   # groups nest: "0.sensors/imu"
+    cmd "sim" {
+      exec = "${VIMOT_BIN}/vimot-sim";  # /bin/sh -c; ${VAR} and $VAR come from
+                                        # the environment, $$ is a literal $
+      host = "localhost";               # other hosts: reported, not started
+      auto_respawn = "true";            # restart on exit; back-off 1 s
+                                        # doubling up to 30 s
+      stop_signal = 15;                 # default 2 (SIGINT)
+      stop_time_allowed = 5;            # s before SIGKILL, default 7
+    }
+  }
+  cmd "logger" { exec = "lcm-logger -f out.lcm"; }
+  script "start_all" {
+    start group "0.sensors";            # start|stop|restart cmd|group|everything
+    start cmd "logger" wait "running";  # optional: wait "running"|"stopped"
+    wait ms 500;
+    wait cmd "sim" status "stopped";    # wait cmd|group "x" status "..."
+    run_script "other";
+  }
+
+environment: VIMOT_BIN is set for the commands to the directory of this
+binary unless already set.
+
+exit status: that of the --exit-when command (128+N if killed by signal N);
+128+N when stopped by signal N; 0 after --duration; when everything ended on
+its own, 0 if all exited with 0, else 1; 1 if a script failed; 2 for a bad
+command line or config.
+)";
+
+// Written by the signal handler, read by the loop: lock-free atomics are
+// async-signal-safe, and exchange() loses no signal between read and reset.
+std::atomic<int> g_pending_signal{0};
+
+void OnSignal(int signal) { g_pending_signal.store(signal); }
+
+void InstallSignalHandlers() {
+  struct sigaction action {};
+  action.sa_handler = OnSignal;
+  sigemptyset(&action.sa_mask);
+  // No SA_RESTART: the signal must interrupt the runner's poll() so the stop
+  // begins at once.
+  action.sa_flags = 0;
+  for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaction(s, &action, nullptr);
+  // A closed stdout (`vimot-sheriff ... | head`) must not kill the sheriff
+  // before it has stopped its children.
+  signal(SIGPIPE, SIG_IGN);
+}
+
+// Directory of this executable, so configs can say ${VIMOT_BIN}/vimot-sim.
+std::optional<std::string> ExecutableDirectory() {
+  std::vector<char> path(PATH_MAX + 1, '\0');
+  const ssize_t n = readlink("/proc/self/exe", path.data(), path.size() - 1);
+  if (n <= 0) return std::nullopt;
+  const std::string exe(path.data(), static_cast<std::size_t>(n));
+  const std::size_t slash = exe.rfind('/');
+  if (slash == std::string::npos) return std::nullopt;
+  return slash == 0 ? "/" : exe.substr(0, slash);
+}
+
+struct CommandLine {
+  SheriffOptions options;
+  std::string config_path;
+  bool list{false};
+  bool help{false};
+};
+
+CommandLine ParseCommandLine(int argc, char** argv) {
+  CommandLine cl;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    std::string arg = args[i];
+    std::optional<std::string> inline_value;
+    if (arg.rfind("--", 0) == 0 && arg.find('=') != std::string::npos) {
+      inline_value = arg.substr(arg.find('=') + 1);
+      arg = arg.substr(0, arg.find('='));
+    }
+    const auto value = [&]() -> std::string {
+      if (inline_value) return *inline_value;
+      if (i + 1 >= args.size()) {
+        throw std::invalid_argument(arg + " needs a value");
+      }
+      return args[++i];
+    };
+    if (arg == "-h" || arg == "--help") {
+      cl.help = true;
+    } else if (arg == "--list") {
+      cl.list = true;
+    } else if (arg == "--script") {
+      cl.options.script = value();
+    } else if (arg == "--group") {
+      cl.options.group = value();
+    } else if (arg == "--exit-when") {
+      cl.options.exit_when = value();
+    } else if (arg == "--duration") {
+      const std::string text = value();
+      char* end = nullptr;
+      errno = 0;
+      const double seconds = std::strtod(text.c_str(), &end);
+      if (text.empty() || *end != '\0' || errno != 0 || !std::isfinite(seconds) ||
+          seconds <= 0.0) {
+        throw std::invalid_argument(
+            "--duration needs a positive number of seconds, got '" + text + "'");
+      }
+      cl.options.duration =
+          std::chrono::milliseconds(static_cast<long long>(std::ceil(seconds * 1000.0)));
+    } else if (arg.size() > 1 && arg[0] == '-') {
+      throw std::invalid_argument("unknown option '" + arg + "'");
+    } else if (cl.config_path.empty()) {
+      cl.config_path = arg;
+    } else {
+      throw std::invalid_argument("more than one config file given ('" +
+                                  cl.config_path + "' and '" + arg + "')");
+    }
+  }
+  if (!cl.help && cl.config_path.empty()) {
+    throw std::invalid_argument("no config file given");
+  }
+  return cl;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CommandLine cl;
+  try {
+    cl = ParseCommandLine(argc, argv);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "vimot-sheriff: " << e.what() << "\n"
+              << "run 'vimot-sheriff --help' for usage\n";
+    return kUsageError;
+  }
+  if (cl.help) {
+    std::cout << kUsage;
+    return 0;
+  }
+
+  vimot::sheriff::SheriffConfig config;
+  try {
+    config = vimot::sheriff::LoadSheriffConfig(cl.config_path);
+  } catch (const std::exception& e) {
+    std::cerr << "vimot-sheriff: " << e.what() << "\n";
+    return kUsageError;
+  }
+  if (cl.list) {
+    for (const auto& w : config.warnings()) std::cerr << w.ToString() << "\n";
+    std::cout << vimot::sheriff::DescribeConfig(config);
+    return 0;
+  }
+
+  if (std::getenv("VIMOT_BIN") == nullptr) {
+    if (const auto dir = ExecutableDirectory()) {
+      cl.options.runner.environment["VIMOT_BIN"] = *dir;
+    }
+  }
+  std::optional<Sheriff> sheriff;
+  try {
+    sheriff.emplace(std::move(config), std::move(cl.options));
+  } catch (const std::exception& e) {
+    // The options do not fit the config, or an exec uses an undefined
+    // variable: nothing has been started.
+    std::cerr << "vimot-sheriff: " << e.what() << "\n";
+    return kUsageError;
+  }
+  InstallSignalHandlers();
+  try {
+    return sheriff->Run([]() { return g_pending_signal.exchange(0); });
+  } catch (const std::exception& e) {
+    // ~Sheriff kills whatever is still running.
+    std::cerr << "vimot-sheriff: internal error: " << e.what() << "\n";
+    return 1;
+  }
+}
