@@ -1,5 +1,7 @@
 // vimot-log-summary: what an LCM log holds — per channel the message type,
-// count, rate, and whether every message decodes as that type.
+// count, rate, and whether every message decodes as that type. Rates use the
+// messages' own utimes (every vimot message starts with it), so a log
+// recorded at 10x real time still shows sensor rates.
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -13,6 +15,14 @@
 #include "common/process/process.h"
 
 namespace {
+
+// The utime field that follows the 8-byte fingerprint, big-endian.
+int64_t message_utime(const void* data) {
+  const auto* b = static_cast<const uint8_t*>(data) + 8;
+  uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | b[i];
+  return static_cast<int64_t>(v);
+}
 
 struct ChannelStats {
   std::set<std::string> types;
@@ -49,8 +59,10 @@ int run(int argc, const char* const* argv) {
         ++undecodable;
       }
     }
-    if (s.count == 0) s.first_utime = ev->timestamp;
-    s.last_utime = ev->timestamp;
+    // Messages of other packages have no known utime: use the log's clock.
+    const int64_t utime = type != nullptr && ev->datalen >= 16 ? message_utime(ev->data) : ev->timestamp;
+    if (s.count == 0) s.first_utime = utime;
+    s.last_utime = utime;
     ++s.count;
     s.bytes += ev->datalen;
     ++total;
