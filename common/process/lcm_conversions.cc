@@ -127,4 +127,46 @@ GroundTruth from_lcm(const ground_truth_t& msg) {
   return t;
 }
 
+nav_state_t to_lcm(const NavState& s) {
+  nav_state_t msg{};
+  msg.utime = s.utime;
+  msg.updated = s.updated;
+  write<4>(s.q_GtoI, msg.q_GtoI);
+  write<3>(s.p_IinG, msg.p_IinG);
+  write<3>(s.v_IinG, msg.v_IinG);
+  write<3>(s.bias_gyro, msg.bias_gyro);
+  write<3>(s.bias_accel, msg.bias_accel);
+  for (int r = 0; r < 15; ++r)
+    for (int c = 0; c < 15; ++c) msg.covariance[r * 15 + c] = s.covariance(r, c);
+  msg.num_clones = s.num_clones;
+  msg.num_slam_features = s.num_slam_features;
+  msg.num_msckf_features = s.num_msckf_features;
+  return msg;
+}
+
+NavState from_lcm(const nav_state_t& msg) {
+  NavState s;
+  s.utime = msg.utime;
+  s.updated = msg.updated;
+  s.q_GtoI = read<4>(msg.q_GtoI, "nav_state_t.q_GtoI", msg.utime);
+  s.p_IinG = read<3>(msg.p_IinG, "nav_state_t.p_IinG", msg.utime);
+  s.v_IinG = read<3>(msg.v_IinG, "nav_state_t.v_IinG", msg.utime);
+  s.bias_gyro = read<3>(msg.bias_gyro, "nav_state_t.bias_gyro", msg.utime);
+  s.bias_accel = read<3>(msg.bias_accel, "nav_state_t.bias_accel", msg.utime);
+  for (int r = 0; r < 15; ++r) {
+    for (int c = 0; c < 15; ++c) {
+      const double v = msg.covariance[r * 15 + c];
+      if (!std::isfinite(v)) {
+        throw std::invalid_argument("nav_state_t.covariance has a non-finite value at utime " +
+                                    std::to_string(msg.utime));
+      }
+      s.covariance(r, c) = v;
+    }
+  }
+  s.num_clones = msg.num_clones;
+  s.num_slam_features = msg.num_slam_features;
+  s.num_msckf_features = msg.num_msckf_features;
+  return s;
+}
+
 }  // namespace vimot

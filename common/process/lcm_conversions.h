@@ -5,10 +5,12 @@
 // std::invalid_argument saying what; the scaffold counts it as an error.
 
 #include "common/types/ground_truth.h"
+#include "common/types/nav_state.h"
 #include "common/types/sensor_data.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
 #include "vimot/imu_t.hpp"
+#include "vimot/nav_state_t.hpp"
 
 namespace vimot {
 
@@ -20,5 +22,8 @@ CameraFrame from_lcm(const features_t& msg);
 
 ground_truth_t to_lcm(const GroundTruth& truth);
 GroundTruth from_lcm(const ground_truth_t& msg);
+
+nav_state_t to_lcm(const NavState& state);
+NavState from_lcm(const nav_state_t& msg);
 
 }  // namespace vimot

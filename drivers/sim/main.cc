@@ -96,6 +96,8 @@ int run(int argc, const char* const* argv) {
   process.args().add_option("speed", "FACTOR", "real-time factor when publishing; 0 = as fast as possible", "1");
   process.args().add_option("start-delay", "SECONDS", "wait before the first message (lets subscribers start)", "0");
   process.args().add_option("log", "FILE", "write an LCM log file instead of publishing (as fast as possible)");
+  process.args().add_option("linger", "SECONDS",
+                            "stay alive this long after the last message (lets consumers drain their queues)", "0");
   if (!process.init(argc, argv)) return 0;
 
   vimot::sim::SimConfig config = vimot::sim::from_config(process.config());
@@ -147,6 +149,12 @@ int run(int argc, const char* const* argv) {
   }
   log_info(process.stop_requested() ? "stopped early: " : "done: ", counts[0], " on ", imu_channel, ", ", counts[1],
            " on ", features_channel, ", ", counts[2], " on ", truth_channel);
+  const auto linger_end = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(process.args().get_double("linger")));
+  while (!process.stop_requested() && std::chrono::steady_clock::now() < linger_end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
   return 0;
 }
 
