@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # The README's main job: the simulated scenario through the LCM stack.
 # Installs what is missing, builds, starts the processes of
-# sheriff_configs/sim_demo.pmd with vimot-sheriff (lcm-logger included), and
-# prints a summary: processes, messages per channel, log path.
+# sheriff_configs/sim_demo.pmd with vimot-sheriff (simulator, vins,
+# lcm-logger), and prints a summary: processes, messages per channel, the
+# VIO accuracy of the LCM run against ground truth, the same scenario run
+# offline (in-process, same libraries) for comparison, and the log path.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml)
 #   VIMOT_SPEED       simulator real-time factor (default 4)
 #   VIMOT_SEED        noise seed (default 1)
+#   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
 #   LCM_DEFAULT_URL   LCM network (default udpm://239.255.76.67:7667?ttl=0,
 #                     which never leaves this machine)
@@ -16,7 +19,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${VIMOT_BUILD_DIR:-$here/build}"
 
 case "${1:-}" in
-  -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 esac
 
 "$here/scripts/build.sh"
@@ -26,6 +29,7 @@ export VIMOT_CONFIG="$here/config"
 export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
 export VIMOT_SPEED="${VIMOT_SPEED:-4}"
 export VIMOT_SEED="${VIMOT_SEED:-1}"
+export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins.yaml}"
 export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}"
 out="${VIMOT_OUT:-$here/out/demo-$(date +%Y%m%d-%H%M%S)}"
 mkdir -p "$out"
@@ -49,5 +53,13 @@ fi
 
 echo "== messages per channel in the log:"
 "$VIMOT_BIN/vimot-log-summary" "$VIMOT_LOG" | sed 's/^/   /'
+echo "== VIO accuracy of the LCM run (VINS_STATE vs GROUND_TRUTH):"
+perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" | head -n 1)
+"$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+  --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
+  --perturb-seed "${perturb_seed:-0}" --out "$out/offline" --quiet > "$out/offline.txt" 2>&1 || true
+"$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --json "$out/lcm_summary.json" \
+  --compare "$out/offline/summary.json" | sed 's/^/   /'
+echo "   (offline run of the same scenario and seed: $out/offline.txt)"
 echo "== log: $VIMOT_LOG"
 echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"

@@ -93,14 +93,30 @@ ScenarioMotion make_trajectory(const SimConfig& config) {
                   kMinFileSplineDt);
   }
   BsplineSE3 spline = BsplineSE3::fit(traj.poses, dt);
-  const double available = spline.end_time() - spline.start_time();
+  double t_begin = spline.start_time();
+  if (config.trajectory.start_distance > 0.0) {
+    // Walk the path at 100 Hz until it is start_distance long.
+    double travelled = 0.0;
+    Eigen::Vector3d previous = spline.evaluate(t_begin).p_BinG;
+    while (travelled < config.trajectory.start_distance) {
+      t_begin += 0.01;
+      if (t_begin >= spline.end_time()) {
+        throw std::invalid_argument("trajectory scenario: the path of '" + traj.path + "' is shorter than " +
+                                    "trajectory.start_distance " + fmt(config.trajectory.start_distance) + " m");
+      }
+      const Eigen::Vector3d p = spline.evaluate(t_begin).p_BinG;
+      travelled += (p - previous).norm();
+      previous = p;
+    }
+  }
+  const double available = spline.end_time() - t_begin;
   if (config.duration > available) {
     throw std::invalid_argument("trajectory scenario: duration " + fmt(config.duration) + " s exceeds the " +
                                 fmt(available) + " s the spline of '" + traj.path + "' covers");
   }
   const double duration = config.duration > 0.0 ? config.duration : available;
   ScenarioMotion m{std::move(spline), std::nullopt, 0.0, duration, Eigen::AlignedBox2d()};
-  m.t_begin = m.robot.start_time();
+  m.t_begin = t_begin;
   m.workspace = bounds_of(m.robot, m.target, m.t_begin, available, config.map.margin);
   return m;
 }

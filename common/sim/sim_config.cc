@@ -99,6 +99,7 @@ std::string problem(const SimConfig& c) {
     case Scenario::kTrajectory:
       if (c.trajectory.file.empty()) err << "key 'trajectory.file' must name a trajectory file";
       else non_negative("trajectory.spline_dt", c.trajectory.spline_dt);
+      non_negative("trajectory.start_distance", c.trajectory.start_distance);
       break;
     case Scenario::kMono:
       if (positive("mono.duration", c.mono.duration) && positive("mono.spline_dt", c.mono.spline_dt)) {
@@ -350,7 +351,7 @@ SimConfig from_config(const Config& config) {
   if (config.has("paper.oscillation")) r.read_sinusoid("paper.oscillation", &c.paper.oscillation);
   r.read("paper.spline_dt", &c.paper.spline_dt);
 
-  r.only_keys("trajectory", {"file", "spline_dt"});
+  r.only_keys("trajectory", {"file", "spline_dt", "start_distance"});
   if (config.has("trajectory.file")) {
     const std::string raw = config.get<std::string>("trajectory.file");
     // A path from an environment variable is taken as given; a literal
@@ -360,6 +361,7 @@ SimConfig from_config(const Config& config) {
                                                                    config.source());
   }
   r.read("trajectory.spline_dt", &c.trajectory.spline_dt);
+  r.read("trajectory.start_distance", &c.trajectory.start_distance);
 
   r.only_keys("mono", {"duration", "object_center", "object_amplitude", "object_frequency_hz", "object_phase",
                        "camera_anchor", "camera_pointing", "camera_base", "camera_velocity", "camera_translation",

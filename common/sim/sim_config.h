@@ -108,6 +108,11 @@ struct TrajectoryScenarioConfig {
   std::string file;             // TUM trajectory (pose of I in G)
   /// Control pose spacing (s); 0 = OpenVINS rule max(mean file dt, 0.05).
   double spline_dt{0.0};
+  /// Start where the body has moved this far along its path (m): OpenVINS's
+  /// simulator starts only once the platform moves (its
+  /// sim_distance_threshold, 1.2 m), so a side-by-side run must too. 0 =
+  /// from the spline's first valid time.
+  double start_distance{0.0};
 };
 
 /// Where the mono camera's position is defined.

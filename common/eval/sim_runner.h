@@ -1,0 +1,122 @@
+#pragma once
+// The estimator on the simulator, end to end, without LCM: what the `vins`
+// process does with the simulator's messages, run offline and as fast as
+// the CPU allows, plus the evaluation against the simulator's truth.
+//
+// One run: build the Simulator (GroundTruth events forced on), start the
+// estimator from initial_estimate(sim.initial_state(), options,
+// perturb_seed) at the first utime, then feed every IMU sample
+// (feed_imu) and camera frame (feed_camera) in the simulator's order. The
+// evaluation samples are the states right after each processed camera
+// frame — nav_state_of(estimator, updated = true), exactly what the `vins`
+// process publishes on VINS_STATE with updated = true — each compared with
+// the GroundTruth event of the same utime (error_of, common/eval/metrics.h).
+// A frame the estimator does not process (diverged, no IMU) gives no sample;
+// a run stops at divergence and says so.
+//
+// Monte Carlo: run i uses simulator seed first_seed + i (new noise, same
+// truth and map) and perturbation seed perturb_seed_for_run(first_seed + i).
+// Runs are independent and deterministic, so the results are the same
+// whatever the thread count (only the CPU times differ). No LCM here.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/estimator/vio_estimator.h"
+#include "common/eval/alignment.h"
+#include "common/eval/metrics.h"
+#include "common/sim/sim_config.h"
+
+namespace vimot {
+namespace eval {
+
+/// One evaluation sample: the state after a camera update and its errors.
+struct FrameSample {
+  int64_t utime{0};                                  // µs
+  Eigen::Vector4d q_GtoI{0.0, 0.0, 0.0, 1.0};        // estimate, JPL
+  Eigen::Vector3d p_IinG{Eigen::Vector3d::Zero()};    // estimate, m
+  Eigen::Vector3d v_IinG{Eigen::Vector3d::Zero()};    // estimate, m/s
+  Eigen::Matrix<double, 15, 1> cov_diag{Eigen::Matrix<double, 15, 1>::Zero()};  // [δθ δp δv δbg δba]
+  Eigen::Vector4d q_GtoI_true{0.0, 0.0, 0.0, 1.0};
+  Eigen::Vector3d p_IinG_true{Eigen::Vector3d::Zero()};
+  ErrorSample error;
+  double cpu_ms{0.0};        // CPU time of this frame's feed_camera (thread CPU clock)
+  int num_slam{0};           // SLAM landmarks in the state after the frame
+  int num_msckf{0};          // MSCKF features used in this frame
+};
+
+struct SimRunOptions {
+  bool keep_samples{true};  // false: only the summary (long Monte Carlo)
+  /// Fraction of the run's camera frames done, after every frame (called
+  /// on the thread running the simulation).
+  std::function<void(double)> progress;
+  /// After every sample, with the estimator (tests, custom metrics).
+  std::function<void(const estimator::VioEstimator&, const FrameSample&)> on_frame;
+};
+
+struct SimRunResult {
+  uint64_t sim_seed{0};
+  uint64_t perturb_seed{0};
+  std::vector<FrameSample> samples;  // empty unless keep_samples
+  ErrorSummary errors;
+  /// ATE after a yaw + translation alignment (alignment.h), for comparison
+  /// with OpenVINS's ov_eval figures only.
+  AlignedErrors aligned;
+  TimingStats timing;                // per processed frame, CPU ms
+  estimator::FrameTiming mean_stage_ms;  // per-stage wall-clock ms, mean over processed frames
+  double static_obs_per_camera{0.0};  // mean static observations per camera and frame
+  estimator::UpdateStats totals;     // summed over the run
+  double path_length_m{0.0};         // of the simulated IMU path
+  double duration_s{0.0};            // simulated
+  int64_t camera_frames{0};          // emitted by the simulator
+  int64_t frames_processed{0};
+  int64_t frames_dropped{0};
+  int64_t frames_without_truth{0};   // processed, but no GroundTruth at that utime
+  int64_t target_observations_ignored{0};
+  bool diverged{false};
+  std::string divergence_reason;
+  double wall_s{0.0};
+};
+
+/// One run on `sim_config` (its seed and duration as given).
+SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
+                            uint64_t perturb_seed, const SimRunOptions& run_options = {});
+
+struct MonteCarloOptions {
+  int runs{30};
+  uint64_t first_seed{1};
+  int threads{0};                  // 0: std::thread::hardware_concurrency()
+  bool perturb{true};              // false: every run starts exactly at the truth
+  bool keep_samples{true};
+  /// Nonzero: every run uses this perturbation seed (to reproduce one run
+  /// of the `vins` process, whose config names its seed).
+  uint64_t fixed_perturb_seed{0};
+};
+
+/// Progress of a Monte Carlo: runs finished and the total fraction done.
+struct MonteCarloProgress {
+  int runs_done{0};
+  int runs_total{0};
+  double fraction{0.0};  // in [0, 1], counting partly done runs
+  double elapsed_s{0.0};
+};
+
+/// Perturbation seed of run with simulator seed `sim_seed` under `o`.
+uint64_t perturb_seed_of(const MonteCarloOptions& o, uint64_t sim_seed);
+
+/// Runs o.runs independent runs on o.threads std::threads; results in run
+/// order. `progress` is called on the calling thread, about every 0.25 s
+/// and once at the end. The first exception of a run is rethrown after all
+/// threads are joined.
+std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const estimator::VioOptions& options,
+                                          const MonteCarloOptions& o,
+                                          const std::function<void(const MonteCarloProgress&)>& progress = {});
+
+/// The per-run error summaries of a Monte Carlo, aggregated.
+MonteCarloSummary aggregate(const std::vector<SimRunResult>& runs);
+
+}  // namespace eval
+}  // namespace vimot

@@ -1,0 +1,49 @@
+#pragma once
+// Pairs published estimates with ground truth by exact utime, for
+// evaluating a recorded run (vimot-log-eval). Only states with
+// updated = true (right after a camera update) are evaluated, the same
+// samples run_vio_on_sim uses. Arrival order does not matter: states and
+// truths are collected, then matched. No LCM here.
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "common/eval/metrics.h"
+#include "common/types/ground_truth.h"
+#include "common/types/nav_state.h"
+
+namespace vimot {
+namespace eval {
+
+struct MatchCounts {
+  int64_t states{0};            // every state given
+  int64_t updated_states{0};    // with updated = true
+  int64_t duplicate_states{0};  // updated state at a utime already seen (first kept)
+  int64_t truths{0};
+  int64_t duplicate_truths{0};  // (first kept)
+  int64_t matched{0};           // updated states with truth at the same utime
+  int64_t unmatched{0};         // updated states without
+  int64_t bad_covariance{0};    // matched, but a 3×3 block not positive definite (skipped)
+};
+
+class TruthMatcher {
+ public:
+  void add_state(const NavState& state);
+  void add_truth(const GroundTruth& truth);
+
+  /// Matches everything given so far; samples in utime order.
+  std::vector<ErrorSample> match(MatchCounts* counts) const;
+
+ private:
+  struct Pose {
+    Eigen::Vector4d q_GtoI;
+    Eigen::Vector3d p_IinG;
+  };
+  std::map<int64_t, NavState> states_;  // updated states by utime
+  std::map<int64_t, Pose> truths_;
+  MatchCounts counts_;
+};
+
+}  // namespace eval
+}  // namespace vimot

@@ -1,0 +1,117 @@
+#include "common/eval/vins_config.h"
+
+#include <sstream>
+
+#include "common/config/config.h"
+
+namespace vimot {
+namespace eval {
+
+namespace {
+
+std::string directory_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+std::string resolve_relative(const std::string& path, const std::string& base_file) {
+  if (path.empty() || path[0] == '/') return path;
+  return directory_of(base_file) + "/" + path;
+}
+
+estimator::InitMode read_mode(const Config& cfg) {
+  const std::string mode = cfg.get_or<std::string>("init.mode", "ground_truth");
+  if (mode == "ground_truth") return estimator::InitMode::kGroundTruth;
+  if (mode == "static") return estimator::InitMode::kStatic;
+  cfg.fail("init.mode", "must be 'ground_truth' or 'static', got '" + mode + "'");
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+bool same_camera(const CameraCalibration& a, const CameraCalibration& b) {
+  return a.width == b.width && a.height == b.height && a.intrinsics == b.intrinsics &&
+         a.distortion == b.distortion && a.R_ItoC == b.R_ItoC && a.p_IinC == b.p_IinC;
+}
+
+}  // namespace
+
+estimator::VioOptions vio_options_from_config(const Config& cfg) {
+  if (cfg.has("estimator.init.mode")) {
+    cfg.fail("estimator.init.mode", "is set by the top-level 'init.mode' of a vins config");
+  }
+  const bool has_calib = cfg.has("calibration_file");
+  const Config calib = has_calib ? Config::load_file(resolve_relative(cfg.get<std::string>("calibration_file"),
+                                                                      cfg.source()))
+                                 : cfg;
+  estimator::VioOptions o = estimator::VioOptions::from_config(cfg, calib, "estimator");
+  o.init_mode = read_mode(cfg);
+  return o;
+}
+
+estimator::VioOptions load_vio_options(const std::string& vins_yaml) {
+  return vio_options_from_config(Config::load_file(vins_yaml));
+}
+
+VinsStartOptions start_options_from_config(const Config& cfg) {
+  VinsStartOptions s;
+  s.mode = read_mode(cfg);
+  const int64_t seed = cfg.get_or<int64_t>("init.perturb_seed", 0);
+  if (seed < 0) cfg.fail("init.perturb_seed", "must be >= 0 (0 = no perturbation), got " + std::to_string(seed));
+  s.perturb_seed = static_cast<uint64_t>(seed);
+  return s;
+}
+
+VinsStartOptions load_start_options(const std::string& vins_yaml) {
+  return start_options_from_config(Config::load_file(vins_yaml));
+}
+
+std::vector<std::string> model_mismatches(const estimator::VioOptions& o, const sim::SimConfig& s) {
+  std::vector<std::string> out;
+  auto cmp = [&out](const std::string& what, double est, double sim, const std::string& unit) {
+    if (est != sim) out.push_back(what + ": estimator " + num(est) + unit + ", simulator " + num(sim) + unit);
+  };
+  const estimator::ImuNoise& n = o.propagator.noise;
+  if (s.imu.noise) {
+    cmp("gyroscope noise density", n.sigma_w, s.imu.gyroscope_noise_density, " rad/s/sqrt(Hz)");
+    cmp("accelerometer noise density", n.sigma_a, s.imu.accelerometer_noise_density, " m/s^2/sqrt(Hz)");
+    cmp("gyroscope random walk", n.sigma_wb, s.imu.gyroscope_random_walk, " rad/s^2/sqrt(Hz)");
+    cmp("accelerometer random walk", n.sigma_ab, s.imu.accelerometer_random_walk, " m/s^3/sqrt(Hz)");
+  } else {
+    out.push_back("IMU noise: off in the simulator, the estimator assumes noise");
+  }
+  cmp("gravity", o.propagator.gravity_magnitude, s.imu.gravity, " m/s^2");
+  cmp("pixel noise", o.sigma_px, s.camera.pixel_noise, " px");
+  const std::size_t used = o.use_stereo ? o.cameras.size() : std::min<std::size_t>(1, o.cameras.size());
+  const std::size_t simulated = s.camera.calibrations.size();
+  if (used != simulated) {
+    out.push_back("cameras: estimator uses " + std::to_string(used) + ", simulator has " +
+                  std::to_string(simulated));
+  }
+  for (std::size_t i = 0; i < std::min(o.cameras.size(), simulated); ++i) {
+    if (!same_camera(o.cameras[i], s.camera.calibrations[i])) {
+      out.push_back("cam" + std::to_string(i) + ": calibrations differ");
+    }
+  }
+  return out;
+}
+
+estimator::VioOptions options_matching_sim(estimator::VioOptions o, const sim::SimConfig& s) {
+  o.cameras = s.camera.calibrations;
+  o.use_stereo = o.cameras.size() >= 2;
+  o.sigma_px = s.camera.pixel_noise;
+  o.propagator.noise.sigma_w = s.imu.gyroscope_noise_density;
+  o.propagator.noise.sigma_a = s.imu.accelerometer_noise_density;
+  o.propagator.noise.sigma_wb = s.imu.gyroscope_random_walk;
+  o.propagator.noise.sigma_ab = s.imu.accelerometer_random_walk;
+  o.propagator.gravity_magnitude = s.imu.gravity;
+  o.static_init.gravity_magnitude = s.imu.gravity;
+  return o;
+}
+
+}  // namespace eval
+}  // namespace vimot

@@ -1,0 +1,78 @@
+#include "procs/eval/log_eval.h"
+
+#include <lcm/lcm-cpp.hpp>
+#include <stdexcept>
+
+#include "common/process/lcm_conversions.h"
+
+namespace vimot {
+namespace eval {
+
+namespace {
+
+// Decodes a whole event as Msg; lcm-gen decoders may throw on a corrupt
+// array length instead of returning < 0: both are a malformed message.
+template <typename Msg>
+bool decode(const lcm::LogEvent& ev, Msg* msg, std::string* why) {
+  try {
+    if (msg->decode(ev.data, 0, ev.datalen) != ev.datalen) {
+      *why = "does not decode as " + std::string(Msg::getTypeName());
+      return false;
+    }
+  } catch (const std::exception& e) {
+    *why = "does not decode as " + std::string(Msg::getTypeName()) + " (" + e.what() + ")";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& options) {
+  lcm::LogFile log(path, "r");
+  if (!log.good()) throw std::runtime_error("cannot open LCM log '" + path + "'");
+
+  LogEvalResult r;
+  TruthMatcher matcher;
+  auto malformed = [&r](int64_t* counter, const lcm::LogEvent& ev, const std::string& why) {
+    ++*counter;
+    if (r.first_malformed.empty()) {
+      r.first_malformed = "event " + std::to_string(ev.eventnum) + " on " + ev.channel + ": " + why;
+    }
+  };
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    ++r.events;
+    std::string why;
+    if (ev->channel == options.state_channel) {
+      nav_state_t msg;
+      if (!decode(*ev, &msg, &why)) {
+        malformed(&r.malformed_states, *ev, why);
+        continue;
+      }
+      try {
+        matcher.add_state(from_lcm(msg));
+      } catch (const std::invalid_argument& e) {
+        malformed(&r.malformed_states, *ev, e.what());
+      }
+    } else if (ev->channel == options.truth_channel) {
+      ground_truth_t msg;
+      if (!decode(*ev, &msg, &why)) {
+        malformed(&r.malformed_truths, *ev, why);
+        continue;
+      }
+      try {
+        matcher.add_truth(from_lcm(msg));
+      } catch (const std::invalid_argument& e) {
+        malformed(&r.malformed_truths, *ev, e.what());
+      }
+    }
+  }
+  r.samples = matcher.match(&r.counts);
+  TrajectoryErrors errors;
+  for (const ErrorSample& s : r.samples) errors.add(s);
+  r.summary = errors.summary();
+  return r;
+}
+
+}  // namespace eval
+}  // namespace vimot

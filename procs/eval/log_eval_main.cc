@@ -1,0 +1,112 @@
+// vimot-log-eval: accuracy and consistency of a recorded estimator run (an
+// LCM log from lcm-logger or vimot-sim --log): the nav_state_t messages with
+// updated = true against the ground_truth_t message of the same utime, with
+// the same metrics as vimot-vio-eval. --compare prints the relative
+// difference to an offline run's summary.json.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "common/eval/json.h"
+#include "common/eval/writers.h"
+#include "common/process/arg_parser.h"
+#include "common/process/process.h"
+#include "procs/eval/log_eval.h"
+
+namespace {
+
+using namespace vimot;
+
+double relative_difference(double a, double b) {
+  if (a == b) return 0.0;
+  return std::fabs(a - b) / std::max(std::fabs(b), 1e-300);
+}
+
+int run(int argc, const char* const* argv) {
+  ArgParser args("vimot-log-eval",
+                 "Evaluates an estimator's states in an LCM log against the ground truth in the same\n"
+                 "log: states with updated = true, truth at exactly the same utime. Prints position\n"
+                 "RMSE [m], orientation RMSE [deg], average NEES of position and orientation (ideal 3)\n"
+                 "and the sample count. Malformed messages are counted and skipped.\n"
+                 "Exit status: 0; 2 if no state could be matched; 3 if --tolerance is exceeded;\n"
+                 "1 on bad input.");
+  args.set_positional("LOG", "LCM log file", 1, 1);
+  args.add_option("state-channel", "CHANNEL", "nav_state_t channel", "VINS_STATE");
+  args.add_option("truth-channel", "CHANNEL", "ground_truth_t channel", "GROUND_TRUTH");
+  args.add_option("json", "FILE", "write the summary as JSON (object \"summary\", as vimot-vio-eval's)");
+  args.add_option("csv", "FILE", "write the per-sample errors with 3-sigma bounds (as vimot-vio-eval's)");
+  args.add_option("compare", "SUMMARY_JSON", "print the relative difference to this summary (e.g. an offline run)");
+  args.add_option("tolerance", "REL", "with --compare: exit 3 if a relative difference exceeds REL");
+  if (!args.parse(argc, argv)) return 0;
+  const std::string path = args.positionals()[0];
+
+  eval::LogEvalOptions opt;
+  opt.state_channel = args.get("state-channel");
+  opt.truth_channel = args.get("truth-channel");
+  const eval::LogEvalResult r = eval::evaluate_log(path, opt);
+  const eval::MatchCounts& c = r.counts;
+
+  std::printf("log: %s (%lld events)\n", path.c_str(), static_cast<long long>(r.events));
+  std::printf("states on %s: %lld (updated %lld, duplicate %lld, malformed %lld)\n", opt.state_channel.c_str(),
+              static_cast<long long>(c.states), static_cast<long long>(c.updated_states),
+              static_cast<long long>(c.duplicate_states), static_cast<long long>(r.malformed_states));
+  std::printf("truth on %s: %lld (duplicate %lld, malformed %lld)\n", opt.truth_channel.c_str(),
+              static_cast<long long>(c.truths), static_cast<long long>(c.duplicate_truths),
+              static_cast<long long>(r.malformed_truths));
+  std::printf("matched %lld, without truth %lld, covariance not positive definite %lld\n",
+              static_cast<long long>(c.matched), static_cast<long long>(c.unmatched),
+              static_cast<long long>(c.bad_covariance));
+  if (!r.first_malformed.empty()) std::printf("first malformed message: %s\n", r.first_malformed.c_str());
+  const eval::ErrorSummary& s = r.summary;
+  std::printf("samples %lld  position RMSE %.4f m  orientation RMSE %.4f deg  NEES position %.2f  orientation %.2f\n",
+              static_cast<long long>(s.count), s.rmse_position_m, s.rmse_orientation_deg, s.nees_position,
+              s.nees_orientation);
+
+  if (args.given("json")) {
+    eval::JsonWriter j;
+    j.begin_object();
+    j.field("tool", "vimot-log-eval").field("log", path);
+    j.field("state_channel", opt.state_channel).field("truth_channel", opt.truth_channel);
+    j.key("summary");
+    eval::write_summary_json(j, s);
+    j.key("counts").begin_object();
+    j.field("events", r.events).field("states", c.states).field("updated_states", c.updated_states);
+    j.field("duplicate_states", c.duplicate_states).field("malformed_states", r.malformed_states);
+    j.field("truths", c.truths).field("duplicate_truths", c.duplicate_truths);
+    j.field("malformed_truths", r.malformed_truths).field("matched", c.matched).field("unmatched", c.unmatched);
+    j.field("bad_covariance", c.bad_covariance);
+    j.end_object();
+    j.end_object();
+    eval::write_text_file(args.get("json"), j.str());
+  }
+  if (args.given("csv")) eval::write_errors_csv(args.get("csv"), r.samples);
+
+  int status = s.count > 0 ? 0 : 2;
+  if (args.given("compare")) {
+    const eval::ErrorSummary o = eval::read_summary_json(args.get("compare"));
+    const double tol = args.given("tolerance") ? args.get_double("tolerance") : -1.0;
+    struct Row {
+      const char* name;
+      double log, offline;
+    } rows[] = {{"position RMSE [m]", s.rmse_position_m, o.rmse_position_m},
+                {"orientation RMSE [deg]", s.rmse_orientation_deg, o.rmse_orientation_deg},
+                {"NEES position", s.nees_position, o.nees_position},
+                {"NEES orientation", s.nees_orientation, o.nees_orientation},
+                {"samples", static_cast<double>(s.count), static_cast<double>(o.count)}};
+    std::printf("compare with %s:\n  %-24s %14s %14s %12s\n", args.get("compare").c_str(), "", "this log", "reference",
+                "rel. diff");
+    for (const Row& row : rows) {
+      const double d = relative_difference(row.log, row.offline);
+      std::printf("  %-24s %14.6g %14.6g %12.3e%s\n", row.name, row.log, row.offline, d,
+                  tol >= 0.0 && d > tol ? "  > tolerance" : "");
+      if (tol >= 0.0 && !(d <= tol)) status = 3;
+    }
+  }
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return vimot::run_process_main([&] { return run(argc, argv); });
+}

@@ -1,0 +1,139 @@
+#include "procs/vins/vins_node.h"
+
+#include <sstream>
+
+#include "common/eval/initial_estimate.h"
+
+namespace vimot {
+
+VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, EventCallback on_event)
+    : options_(options), estimator_(options.vio), on_state_(std::move(on_state)), on_event_(std::move(on_event)) {}
+
+void VinsNode::say(VinsEvent::Kind kind, const std::string& message) {
+  if (on_event_) on_event_(VinsEvent{kind, message});
+}
+
+void VinsNode::on_imu(const ImuData& imu) {
+  const estimator::ImuFeedStatus status = estimator_.feed_imu(imu);
+  switch (status) {
+    case estimator::ImuFeedStatus::kAccepted:
+      break;
+    case estimator::ImuFeedStatus::kAcceptedAfterGap:
+      say(VinsEvent::Kind::kInfo, "IMU gap before utime " + std::to_string(imu.utime) + " (propagating across it)");
+      break;
+    default:
+      say(VinsEvent::Kind::kDropped,
+          std::string("IMU sample at utime ") + std::to_string(imu.utime) + ": " + estimator::to_string(status));
+      return;
+  }
+  process_ready_frames(imu.utime);
+  if (options_.publish_imu_rate && queued_frames_.empty()) publish_propagated(imu.utime);
+}
+
+void VinsNode::on_frame(const CameraFrame& frame) {
+  if (frame.utime <= last_frame_utime_) {
+    say(VinsEvent::Kind::kDropped, "camera frame at utime " + std::to_string(frame.utime) +
+                                       (frame.utime == last_frame_utime_ ? " is a duplicate" : " is out of order"));
+    return;
+  }
+  last_frame_utime_ = frame.utime;
+  queued_frames_.push_back(frame);
+  process_ready_frames(estimator_.propagator().latest_utime());
+  while (static_cast<int>(queued_frames_.size()) > options_.max_queued_frames) {
+    say(VinsEvent::Kind::kInfo, "IMU stalled: processing frame " + std::to_string(queued_frames_.front().utime) +
+                                    " without IMU up to its time");
+    process_frame(queued_frames_.front());
+    queued_frames_.pop_front();
+  }
+}
+
+void VinsNode::flush() {
+  while (!queued_frames_.empty()) {
+    process_frame(queued_frames_.front());
+    queued_frames_.pop_front();
+  }
+}
+
+void VinsNode::on_ground_truth(const GroundTruth& truth) {
+  if (!options_.init_from_ground_truth || estimator_.initialized()) return;
+  const eval::InitialEstimate init = eval::initial_estimate(truth, options_.vio, options_.perturb_seed);
+  estimator_.initialize(init.value, truth.utime, init.P0);
+  say(VinsEvent::Kind::kInfo, "initialised from ground truth at utime " + std::to_string(truth.utime));
+}
+
+void VinsNode::process_ready_frames(int64_t latest_imu_utime) {
+  while (!queued_frames_.empty() && queued_frames_.front().utime <= latest_imu_utime) {
+    process_frame(queued_frames_.front());
+    queued_frames_.pop_front();
+  }
+}
+
+void VinsNode::process_frame(const CameraFrame& frame) {
+  const estimator::FrameStatus status = estimator_.feed_camera(frame);
+  switch (status) {
+    case estimator::FrameStatus::kProcessed:
+      publish_updated();
+      return;
+    case estimator::FrameStatus::kDiverged: {
+      ++resets_;
+      std::ostringstream msg;
+      msg << "estimator diverged at utime " << frame.utime << " (" << estimator_.last_divergence().reason
+          << "); reset, re-initialising " << (options_.init_from_ground_truth ? "from ground truth" : "at rest");
+      estimator_.reset();
+      say(VinsEvent::Kind::kError, msg.str());
+      return;
+    }
+    case estimator::FrameStatus::kNotInitialized:
+      say(VinsEvent::Kind::kDropped, "frame at utime " + std::to_string(frame.utime) + " before initialisation");
+      return;
+    default:
+      say(VinsEvent::Kind::kDropped,
+          "frame at utime " + std::to_string(frame.utime) + ": " + estimator::to_string(status));
+      return;
+  }
+}
+
+void VinsNode::publish_updated() {
+  if (!on_state_) return;
+  const estimator::ImuValue x = estimator_.imu_value();
+  NavState s;
+  s.utime = estimator_.state_utime();
+  s.updated = true;
+  s.q_GtoI = x.q_GtoI;
+  s.p_IinG = x.p_IinG;
+  s.v_IinG = x.v_IinG;
+  s.bias_gyro = x.bg;
+  s.bias_accel = x.ba;
+  s.covariance = estimator_.imu_covariance();
+  s.num_clones = static_cast<int>(estimator_.state().clones().size());
+  s.num_slam_features = static_cast<int>(estimator_.state().slam_features().size());
+  s.num_msckf_features = estimator_.last_stats().msckf_used;
+  on_state_(s);
+}
+
+void VinsNode::publish_propagated(int64_t utime) {
+  if (!on_state_ || !estimator_.initialized() || utime <= estimator_.state_utime()) return;
+  // Output only: predicts the IMU marginal from the last update without
+  // touching the filter, so IMU-rate output never changes the estimate.
+  const estimator::ImuValue x0 = estimator_.imu_value();
+  estimator::ImuValue x1;
+  estimator::Matrix15d Phi, Q;
+  estimator::PropagationReport report;
+  if (!estimator_.propagator().predict_interval(x0, x0, estimator_.state_utime(), utime, &x1, &Phi, &Q, &report)) {
+    return;
+  }
+  NavState s;
+  s.utime = utime;
+  s.updated = false;
+  s.q_GtoI = x1.q_GtoI;
+  s.p_IinG = x1.p_IinG;
+  s.v_IinG = x1.v_IinG;
+  s.bias_gyro = x1.bg;
+  s.bias_accel = x1.ba;
+  s.covariance = Phi * estimator_.imu_covariance() * Phi.transpose() + Q;
+  s.num_clones = static_cast<int>(estimator_.state().clones().size());
+  s.num_slam_features = static_cast<int>(estimator_.state().slam_features().size());
+  on_state_(s);
+}
+
+}  // namespace vimot

@@ -1,0 +1,204 @@
+// vimot-log-eval on logs this test writes with lcm::LogFile: known errors
+// give known RMSE/NEES; only updated states count; truth matched by exact
+// utime; corrupt and non-finite messages counted, never fatal. And an
+// offline run pushed through the LCM messages gives the same summary as
+// run_vio_on_sim (the LCM run == offline run check, on the evaluation side).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "common/config/config.h"
+#include "common/eval/json.h"
+#include "common/eval/nav_state_of.h"
+#include "common/eval/sim_runner.h"
+#include "common/eval/vins_config.h"
+#include "common/eval/writers.h"
+#include "common/math/quat.h"
+#include "common/process/lcm_conversions.h"
+#include "procs/eval/log_eval.h"
+
+using namespace vimot;
+using namespace vimot::eval;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+
+namespace {
+
+std::string temp_path(const char* stem) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "/tmp/vimot_logeval_%s_XXXXXX", stem);
+  const int fd = mkstemp(name);
+  REQUIRE(fd >= 0);
+  close(fd);
+  return name;
+}
+
+class LogWriter {
+ public:
+  explicit LogWriter(const std::string& path) : log_(path, "w") { REQUIRE(log_.good()); }
+
+  template <typename Msg>
+  void write(const std::string& channel, const Msg& msg, int64_t utime) {
+    std::vector<uint8_t> buf(static_cast<std::size_t>(msg.getEncodedSize()));
+    REQUIRE(msg.encode(buf.data(), 0, static_cast<int>(buf.size())) == static_cast<int>(buf.size()));
+    raw(channel, buf, utime);
+  }
+  void raw(const std::string& channel, std::vector<uint8_t> bytes, int64_t utime) {
+    lcm::LogEvent ev;
+    ev.eventnum = n_++;
+    ev.timestamp = utime;
+    ev.channel = channel;
+    ev.datalen = static_cast<int32_t>(bytes.size());
+    ev.data = bytes.data();
+    REQUIRE(log_.writeEvent(&ev) == 0);
+  }
+
+ private:
+  lcm::LogFile log_;
+  int64_t n_{0};
+};
+
+GroundTruth truth_at(int64_t utime) {
+  GroundTruth gt;
+  gt.utime = utime;
+  gt.p_IinG = Eigen::Vector3d(0.01 * static_cast<double>(utime), 1.0, 2.0);
+  gt.q_GtoI = rot_to_quat(exp_so3(Eigen::Vector3d(0.1, 0.2, 0.001 * static_cast<double>(utime))));
+  return gt;
+}
+
+// A state with position error err_p (truth − estimate) and orientation error
+// err_theta, covariance σ_p² I and σ_θ² I.
+NavState state_at(int64_t utime, const Eigen::Vector3d& err_p, const Eigen::Vector3d& err_theta, double sigma_p,
+                  double sigma_theta, bool updated = true) {
+  const GroundTruth gt = truth_at(utime);
+  NavState s;
+  s.utime = utime;
+  s.updated = updated;
+  s.p_IinG = gt.p_IinG - err_p;
+  // truth = est ⊞ err  ->  est = Exp(err) R_true
+  s.q_GtoI = rot_to_quat(exp_so3(err_theta) * quat_to_rot(gt.q_GtoI));
+  s.covariance = Eigen::Matrix<double, 15, 15>::Identity();
+  s.covariance.block<3, 3>(0, 0) = sigma_theta * sigma_theta * Eigen::Matrix3d::Identity();
+  s.covariance.block<3, 3>(3, 3) = sigma_p * sigma_p * Eigen::Matrix3d::Identity();
+  return s;
+}
+
+int run_command(const std::string& cmd) {
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+TEST_CASE("Log evaluation: known errors, updated states only, corrupt messages counted", "[eval][log]") {
+  const std::string path = temp_path("log");
+  {
+    LogWriter w(path);
+    for (int64_t t = 100; t <= 400; t += 100) w.write("GROUND_TRUTH", to_lcm(truth_at(t)), t);
+    w.write("GROUND_TRUTH", to_lcm(truth_at(100)), 100);  // duplicate truth
+    // Updated states with errors |δp| = 0.3 and 0.4 m, |δθ| = 0.01 rad.
+    w.write("VINS_STATE", to_lcm(state_at(100, Eigen::Vector3d(0.3, 0, 0), Eigen::Vector3d(0.01, 0, 0), 0.1, 0.01)),
+            100);
+    w.write("VINS_STATE", to_lcm(state_at(150, Eigen::Vector3d(9, 9, 9), Eigen::Vector3d(1, 0, 0), 0.1, 0.01, false)),
+            150);  // propagation only: ignored
+    w.write("VINS_STATE", to_lcm(state_at(200, Eigen::Vector3d(0, 0.4, 0), Eigen::Vector3d(0, 0, 0.01), 0.2, 0.02)),
+            200);
+    w.write("VINS_STATE", to_lcm(state_at(250, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d::Zero(), 1, 1)),
+            250);  // no truth at 250: unmatched
+    w.raw("VINS_STATE", {0xde, 0xad, 0xbe, 0xef, 1, 2, 3}, 260);  // corrupt
+    nav_state_t nan_state = to_lcm(state_at(300, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 1, 1));
+    nan_state.p_IinG[1] = std::nan("");
+    w.write("VINS_STATE", nan_state, 300);                          // non-finite: malformed
+    w.write("VINS_STATE", to_lcm(truth_at(350)), 350);              // wrong type on the channel
+    w.write("OTHER", to_lcm(truth_at(400)), 400);                   // other channel: ignored
+    w.raw("GROUND_TRUTH", {1, 2, 3}, 410);                          // corrupt truth
+  }
+  const LogEvalResult r = evaluate_log(path);
+  CHECK(r.events == 14);
+  CHECK(r.malformed_states == 3);
+  CHECK(r.malformed_truths == 1);
+  CHECK_FALSE(r.first_malformed.empty());
+  CHECK(r.counts.states == 4);
+  CHECK(r.counts.updated_states == 3);
+  CHECK(r.counts.truths == 5);
+  CHECK(r.counts.duplicate_truths == 1);
+  CHECK(r.counts.matched == 2);
+  CHECK(r.counts.unmatched == 1);
+  REQUIRE(r.summary.count == 2);
+  // RMSE_p = √((0.09 + 0.16)/2) = √0.125; RMSE_θ = 0.01 rad.
+  CHECK_THAT(r.summary.rmse_position_m, WithinRel(std::sqrt(0.125), 1e-9));
+  CHECK_THAT(r.summary.rmse_orientation_deg, WithinRel(0.01 * 180.0 / M_PI, 1e-9));
+  // NEES_p: (0.3/0.1)² = 9 and (0.4/0.2)² = 4 -> 6.5; NEES_θ: 1 and 0.25 -> 0.625.
+  CHECK_THAT(r.summary.nees_position, WithinRel(6.5, 1e-9));
+  CHECK_THAT(r.summary.nees_orientation, WithinRel(0.625, 1e-9));
+  REQUIRE(r.samples.size() == 2);
+  CHECK(r.samples[0].utime == 100);
+  CHECK((r.samples[0].err_p - Eigen::Vector3d(0.3, 0, 0)).norm() < 1e-12);
+
+  LogEvalOptions other;
+  other.state_channel = "NOPE";
+  CHECK(evaluate_log(path, other).summary.count == 0);
+  CHECK_THROWS_AS(evaluate_log("/nonexistent/log"), std::runtime_error);
+
+  // The command line: prints, writes JSON, compares with itself.
+  const std::string json = temp_path("json");
+  const std::string bin = VIMOT_LOG_EVAL_BIN;
+  CHECK(run_command(bin + " " + path + " --json " + json + " > /dev/null") == 0);
+  const ErrorSummary s = read_summary_json(json);
+  CHECK(s.count == 2);
+  CHECK(s.rmse_position_m == r.summary.rmse_position_m);
+  CHECK(run_command(bin + " " + path + " --compare " + json + " --tolerance 1e-12 > /dev/null") == 0);
+  // Against a different reference: exit 3 beyond the tolerance.
+  ErrorSummary other_summary = s;
+  other_summary.rmse_position_m *= 1.1;
+  JsonWriter j;
+  j.begin_object().key("summary");
+  write_summary_json(j, other_summary);
+  j.end_object();
+  write_text_file(json, j.str());
+  CHECK(run_command(bin + " " + path + " --compare " + json + " --tolerance 0.01 > /dev/null") == 3);
+  CHECK(run_command(bin + " " + path + " --state-channel NOPE > /dev/null") == 2);
+  CHECK(run_command(bin + " /nonexistent/log > /dev/null 2>&1") == 1);
+  std::remove(json.c_str());
+  std::remove(path.c_str());
+}
+
+TEST_CASE("An offline run through LCM messages evaluates identically", "[eval][log]") {
+  const std::string src = VIMOT_SOURCE_DIR;
+  sim::SimConfig cfg = sim::from_config(Config::load_file(src + "/config/sim_paper.yaml"));
+  cfg.duration = 2.0;
+  const estimator::VioOptions o = load_vio_options(src + "/config/vins.yaml");
+  const std::string path = temp_path("run");
+  SimRunResult offline;
+  {
+    LogWriter w(path);
+    SimRunOptions ro;
+    ro.on_frame = [&](const estimator::VioEstimator& est, const FrameSample& s) {
+      // What the vins process publishes after a camera update, and a
+      // propagation-only state that must be ignored.
+      NavState prop = nav_state_of(est, false);
+      prop.utime -= 1;
+      w.write("VINS_STATE", to_lcm(prop), s.utime - 1);
+      w.write("VINS_STATE", to_lcm(nav_state_of(est, true)), s.utime);
+      GroundTruth gt;
+      gt.utime = s.utime;
+      gt.q_GtoI = s.q_GtoI_true;
+      gt.p_IinG = s.p_IinG_true;
+      w.write("GROUND_TRUTH", to_lcm(gt), s.utime);
+    };
+    offline = run_vio_on_sim(cfg, o, 3, ro);
+  }
+  const LogEvalResult logged = evaluate_log(path);
+  CHECK(logged.summary.count == offline.errors.count);
+  CHECK(logged.summary.rmse_position_m == offline.errors.rmse_position_m);
+  CHECK(logged.summary.rmse_orientation_deg == offline.errors.rmse_orientation_deg);
+  CHECK(logged.summary.nees_position == offline.errors.nees_position);
+  CHECK(logged.summary.nees_orientation == offline.errors.nees_orientation);
+  std::remove(path.c_str());
+}
