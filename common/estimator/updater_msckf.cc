@@ -56,7 +56,8 @@ bool UpdaterMsckf::feature_system(const State& state, const Feature& feat, Colum
   return true;
 }
 
-void UpdaterMsckf::update(State& state, std::vector<std::shared_ptr<Feature>> features, UpdateStats* stats) const {
+void UpdaterMsckf::update(State& state, std::vector<std::shared_ptr<Feature>> features, UpdateStats* stats,
+                          std::vector<std::shared_ptr<Feature>>* deferred) const {
   if (features.empty() || state.clones().size() < 2) return;
   stats->msckf_candidates += static_cast<int>(features.size());
 
@@ -79,6 +80,7 @@ void UpdaterMsckf::update(State& state, std::vector<std::shared_ptr<Feature>> fe
   });
   if (static_cast<int>(usable.size()) > options_.max_features_per_update) {
     stats->msckf_dropped_over_max += static_cast<int>(usable.size()) - options_.max_features_per_update;
+    if (deferred) deferred->insert(deferred->end(), usable.begin() + options_.max_features_per_update, usable.end());
     usable.resize(options_.max_features_per_update);
   }
   if (usable.empty()) return;

@@ -36,8 +36,12 @@ class UpdaterMsckf {
                const std::vector<CameraInfo>& cameras);
 
   /// Updates `state` with the given tracks (observations at times without
-  /// a clone are dropped). Counts into *stats.
-  void update(State& state, std::vector<std::shared_ptr<Feature>> features, UpdateStats* stats) const;
+  /// a clone are dropped). Counts into *stats. Tracks beyond
+  /// max_features_per_update (the shortest) are not tried: they are
+  /// appended to *deferred if given, so the caller can keep them for a
+  /// later update; every other track has been consumed (used or rejected).
+  void update(State& state, std::vector<std::shared_ptr<Feature>> features, UpdateStats* stats,
+              std::vector<std::shared_ptr<Feature>>* deferred = nullptr) const;
 
   /// The whitened linear system of one triangulated feature over `clones`
   /// (columns in layout order, which must hold every clone the feature is

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -373,8 +374,15 @@ void VioEstimator::process_frame(const CameraFrame& frame) {
   }
 
   Clock::time_point t0 = Clock::now();
-  msckf_.update(st, msckf_feats, &stats);
-  for (const auto& f : msckf_feats) database_.remove(f->feature_id);
+  // Tracks above max_msckf_in_update stay in the database for the next
+  // frame (their measurements were not used); the others are consumed.
+  std::vector<std::shared_ptr<Feature>> deferred;
+  msckf_.update(st, msckf_feats, &stats, &deferred);
+  std::set<int64_t> deferred_ids;
+  for (const auto& f : deferred) deferred_ids.insert(f->feature_id);
+  for (const auto& f : msckf_feats) {
+    if (deferred_ids.count(f->feature_id) == 0) database_.remove(f->feature_id);
+  }
   last_timing_.msckf_ms = ms_since(t0);
 
   t0 = Clock::now();

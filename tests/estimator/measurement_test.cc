@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <functional>
+#include <memory>
 #include <random>
 
 #include "common/estimator/linear_algebra.h"
@@ -303,4 +304,41 @@ TEST_CASE("MSCKF feature system: H_x and H_f are the residual Jacobians", "[meas
     f.p_FinG = pf0;
     CHECK((-(rp - rm) / 2e-6 - H_f.col(i)).cwiseAbs().maxCoeff() < 1e-4);
   }
+}
+
+TEST_CASE("MSCKF update defers the tracks above max_features_per_update", "[msckf]") {
+  const std::vector<CameraInfo> cams = {test_camera(0), test_camera(1)};
+  const std::vector<ClonePose> poses = {test_pose(0), test_pose(1), test_pose(2), test_pose(3)};
+  State st = make_state(poses, /*use_fej=*/false);
+  const ClonePose& a = poses[0];
+  // Three exact tracks over 4, 3 and 2 clone times (stereo).
+  std::vector<std::shared_ptr<Feature>> feats;
+  for (int k = 0; k < 3; ++k) {
+    auto f = std::make_shared<Feature>();
+    f->feature_id = 10 + k;
+    const Eigen::Vector3d p = a.p_IinG + a.R_GtoI.transpose() *
+                                             (cams[0].R_ItoC.transpose() *
+                                              (Eigen::Vector3d(0.2 - 0.3 * k, 0.1 * k, 5.0 + k) - cams[0].p_IinC));
+    int n = 0;
+    for (const auto& kv : st.clones()) {
+      if (n++ >= 4 - k) break;
+      for (int c = 0; c < 2; ++c) {
+        f->obs[c].push_back(FeatureObs{kv.first, project(point_in_camera(kv.second->Rot(), kv.second->pos(), p,
+                                                                           cams[c]))});
+      }
+    }
+    feats.push_back(f);
+  }
+  MsckfOptions opt;
+  opt.max_features_per_update = 1;
+  UpdaterMsckf up(opt, TriangulationOptions{}, cams);
+  UpdateStats stats;
+  std::vector<std::shared_ptr<Feature>> deferred;
+  up.update(st, {feats[2], feats[0], feats[1]}, &stats, &deferred);
+  CHECK(stats.msckf_candidates == 3);
+  CHECK(stats.msckf_dropped_over_max == 2);
+  CHECK(stats.msckf_used == 1);  // the longest track
+  REQUIRE(deferred.size() == 2);
+  CHECK(deferred[0]->feature_id == 11);
+  CHECK(deferred[1]->feature_id == 12);
 }
