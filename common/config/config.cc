@@ -78,6 +78,12 @@ YAML::Node Config::require(const std::string& key) const {
   return n;
 }
 
+std::string Config::resolve_path(const std::string& path) const {
+  if (path.empty() || path[0] == '/') return path;
+  const auto slash = source_.find_last_of('/');
+  return (slash == std::string::npos ? std::string(".") : source_.substr(0, slash)) + "/" + path;
+}
+
 bool Config::has(const std::string& key) const {
   const YAML::Node n = find(key);
   return n.IsDefined() && !n.IsNull();

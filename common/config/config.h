@@ -65,6 +65,10 @@ class Config {
 
   const std::string& source() const { return source_; }
 
+  /// A path written in this config, relative to the config file's folder
+  /// unless absolute (so a config can name its calibration file portably).
+  std::string resolve_path(const std::string& path) const;
+
   /// The key's full dotted path from the file's root ("cameras.cam0.T_BS").
   std::string full_key(const std::string& key) const;
 

@@ -9,16 +9,6 @@ namespace eval {
 
 namespace {
 
-std::string directory_of(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
-}
-
-std::string resolve_relative(const std::string& path, const std::string& base_file) {
-  if (path.empty() || path[0] == '/') return path;
-  return directory_of(base_file) + "/" + path;
-}
-
 estimator::InitMode read_mode(const Config& cfg) {
   const std::string mode = cfg.get_or<std::string>("init.mode", "ground_truth");
   if (mode == "ground_truth") return estimator::InitMode::kGroundTruth;
@@ -45,8 +35,7 @@ estimator::VioOptions vio_options_from_config(const Config& cfg) {
     cfg.fail("estimator.init.mode", "is set by the top-level 'init.mode' of a vins config");
   }
   const bool has_calib = cfg.has("calibration_file");
-  const Config calib = has_calib ? Config::load_file(resolve_relative(cfg.get<std::string>("calibration_file"),
-                                                                      cfg.source()))
+  const Config calib = has_calib ? Config::load_file(cfg.resolve_path(cfg.get<std::string>("calibration_file")))
                                  : cfg;
   estimator::VioOptions o = estimator::VioOptions::from_config(cfg, calib, "estimator");
   o.init_mode = read_mode(cfg);

@@ -167,16 +167,6 @@ class Reader {
   const Config& root_;
 };
 
-std::string directory_of(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
-}
-
-std::string resolve_relative(const std::string& path, const std::string& base_file) {
-  if (path.empty() || path[0] == '/') return path;
-  return directory_of(base_file) + "/" + path;
-}
-
 // Expands ${NAME} from the environment; an unset variable is an error.
 std::string expand_env(const Reader& r, const std::string& key, const std::string& value) {
   std::string out;
@@ -277,8 +267,7 @@ SimConfig from_config(const Config& config) {
   // Calibration: cameras (ASL layout) and IMU noise densities live in the
   // calibration file if one is named, else in this file.
   const Config calib = config.has("calibration_file")
-                           ? Config::load_file(resolve_relative(config.get<std::string>("calibration_file"),
-                                                                config.source()))
+                           ? Config::load_file(config.resolve_path(config.get<std::string>("calibration_file")))
                            : config;
 
   r.only_keys("camera", {"mode", "rate_hz", "pixel_noise", "min_depth", "max_range", "max_depth", "border",
@@ -357,8 +346,7 @@ SimConfig from_config(const Config& config) {
     // A path from an environment variable is taken as given; a literal
     // relative path is relative to the config file.
     c.trajectory.file = raw.rfind("${", 0) == 0 ? expand_env(r, "trajectory.file", raw)
-                                                : resolve_relative(expand_env(r, "trajectory.file", raw),
-                                                                   config.source());
+                                                : config.resolve_path(expand_env(r, "trajectory.file", raw));
   }
   r.read("trajectory.spline_dt", &c.trajectory.spline_dt);
   r.read("trajectory.start_distance", &c.trajectory.start_distance);

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "common/eval/initial_estimate.h"
+#include "common/eval/nav_state_of.h"
 
 namespace vimot {
 
@@ -94,21 +95,7 @@ void VinsNode::process_frame(const CameraFrame& frame) {
 }
 
 void VinsNode::publish_updated() {
-  if (!on_state_) return;
-  const estimator::ImuValue x = estimator_.imu_value();
-  NavState s;
-  s.utime = estimator_.state_utime();
-  s.updated = true;
-  s.q_GtoI = x.q_GtoI;
-  s.p_IinG = x.p_IinG;
-  s.v_IinG = x.v_IinG;
-  s.bias_gyro = x.bg;
-  s.bias_accel = x.ba;
-  s.covariance = estimator_.imu_covariance();
-  s.num_clones = static_cast<int>(estimator_.state().clones().size());
-  s.num_slam_features = static_cast<int>(estimator_.state().slam_features().size());
-  s.num_msckf_features = estimator_.last_stats().msckf_used;
-  on_state_(s);
+  if (on_state_) on_state_(eval::nav_state_of(estimator_, /*updated=*/true));
 }
 
 void VinsNode::publish_propagated(int64_t utime) {
@@ -122,17 +109,14 @@ void VinsNode::publish_propagated(int64_t utime) {
   if (!estimator_.propagator().predict_interval(x0, x0, estimator_.state_utime(), utime, &x1, &Phi, &Q, &report)) {
     return;
   }
-  NavState s;
+  NavState s = eval::nav_state_of(estimator_, /*updated=*/false);
   s.utime = utime;
-  s.updated = false;
   s.q_GtoI = x1.q_GtoI;
   s.p_IinG = x1.p_IinG;
   s.v_IinG = x1.v_IinG;
   s.bias_gyro = x1.bg;
   s.bias_accel = x1.ba;
-  s.covariance = Phi * estimator_.imu_covariance() * Phi.transpose() + Q;
-  s.num_clones = static_cast<int>(estimator_.state().clones().size());
-  s.num_slam_features = static_cast<int>(estimator_.state().slam_features().size());
+  s.covariance = Phi * s.covariance * Phi.transpose() + Q;
   on_state_(s);
 }
 

@@ -90,3 +90,10 @@ TEST_CASE("utime conversions round to the nearest microsecond") {
   CHECK(vimot::seconds_to_utime(2.9999999) == 3000000);
   CHECK(vimot::utime_to_seconds(1500000) == 1.5);
 }
+
+TEST_CASE("paths in a config resolve relative to the config file") {
+  const Config c = Config::from_string("a: 1\n", "/etc/vimot/vins.yaml");
+  CHECK(c.resolve_path("euroc_stereo.yaml") == "/etc/vimot/euroc_stereo.yaml");
+  CHECK(c.resolve_path("/abs/file.yaml") == "/abs/file.yaml");
+  CHECK(Config::from_string("a: 1\n", "local.yaml").resolve_path("x.yaml") == "./x.yaml");
+}
