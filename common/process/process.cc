@@ -116,6 +116,7 @@ int Process::run(const std::function<void()>& idle) {
   while (!stop_requested()) {
     const int status = lcm_->handleTimeout(100);
     if (status < 0) {
+      if (stop_requested()) break;  // a stop signal interrupted the wait
       report_error("LCM handle failed");
       return 1;
     }
