@@ -71,8 +71,44 @@ Eigen::Vector3d anchored_to_global(const Eigen::Vector3d& lambda, const Eigen::M
 
 Eigen::Vector3d global_to_anchored(const Eigen::Vector3d& p_FinG, const Eigen::Matrix3d& R_GtoA,
                                    const Eigen::Vector3d& p_AinG, const CameraInfo& anchor_cam) {
-  const Eigen::Vector3d p_FinCa = point_in_camera(R_GtoA, p_AinG, p_FinG, anchor_cam);
-  return Eigen::Vector3d(p_FinCa.x() / p_FinCa.z(), p_FinCa.y() / p_FinCa.z(), 1.0 / p_FinCa.z());
+  return global_to_anchored(p_FinG, R_GtoA, p_AinG, anchor_cam, nullptr, nullptr);
+}
+
+Eigen::Vector3d global_to_anchored(const Eigen::Vector3d& p_FinG, const Eigen::Matrix3d& R_GtoA,
+                                   const Eigen::Vector3d& p_AinG, const CameraInfo& anchor_cam,
+                                   Eigen::Matrix3d* dl_dpf, Eigen::Matrix<double, 3, 6>* dl_danchor) {
+  const Eigen::Vector3d p_FinA = R_GtoA * (p_FinG - p_AinG);
+  const Eigen::Vector3d p_FinCa = anchor_cam.R_ItoC * p_FinA + anchor_cam.p_IinC;
+  const double iz = 1.0 / p_FinCa.z();
+  if (dl_dpf || dl_danchor) {
+    Eigen::Matrix3d dl_dpc;
+    dl_dpc << iz, 0.0, -p_FinCa.x() * iz * iz, 0.0, iz, -p_FinCa.y() * iz * iz, 0.0, 0.0, -iz * iz;
+    const Eigen::Matrix3d A = dl_dpc * anchor_cam.R_ItoC;
+    if (dl_dpf) *dl_dpf = A * R_GtoA;
+    if (dl_danchor) {
+      dl_danchor->leftCols<3>() = A * skew(p_FinA);
+      dl_danchor->rightCols<3>() = -A * R_GtoA;
+    }
+  }
+  return Eigen::Vector3d(p_FinCa.x() * iz, p_FinCa.y() * iz, iz);
+}
+
+Eigen::Vector3d change_anchor(const Eigen::Vector3d& lambda_A, const Eigen::Matrix3d& R_GtoA,
+                              const Eigen::Vector3d& p_AinG, const CameraInfo& cam_a, const Eigen::Matrix3d& R_GtoB,
+                              const Eigen::Vector3d& p_BinG, const CameraInfo& cam_b,
+                              Eigen::Matrix<double, 3, 15>* J) {
+  Eigen::Matrix3d F_l, G_f;
+  Eigen::Matrix<double, 3, 6> F_a, G_b;
+  const Eigen::Vector3d p_FinG =
+      anchored_to_global(lambda_A, R_GtoA, p_AinG, cam_a, J ? &F_l : nullptr, J ? &F_a : nullptr);
+  const Eigen::Vector3d lambda_B =
+      global_to_anchored(p_FinG, R_GtoB, p_BinG, cam_b, J ? &G_f : nullptr, J ? &G_b : nullptr);
+  if (J) {
+    J->leftCols<3>() = G_f * F_l;
+    J->middleCols<6>(3) = G_f * F_a;
+    J->rightCols<6>() = G_b;
+  }
+  return lambda_B;
 }
 
 }  // namespace estimator

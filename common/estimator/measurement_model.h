@@ -70,6 +70,25 @@ Eigen::Vector3d anchored_to_global(const Eigen::Vector3d& lambda, const Eigen::M
 /// λ of a global point in the anchor camera (inverse of anchored_to_global).
 Eigen::Vector3d global_to_anchored(const Eigen::Vector3d& p_FinG, const Eigen::Matrix3d& R_GtoA,
                                    const Eigen::Vector3d& p_AinG, const CameraInfo& anchor_cam);
+/// ... and its Jacobians w.r.t. the global point (3×3) and the anchor pose
+/// error [δθ_A δp_A] (3×6), nullptr if unneeded. With p_FinCa = [x y z]:
+///   ∂λ/∂p_FinCa = [1/z 0 −x/z²; 0 1/z −y/z²; 0 0 −1/z²]
+///   ∂p_FinCa/∂p_FinG = R_ItoCa R_GtoA,  ∂p_FinCa/∂δθ_A = R_ItoCa [R_GtoA (p_FinG − p_AinG)×],
+///   ∂p_FinCa/∂δp_A = −R_ItoCa R_GtoA.
+Eigen::Vector3d global_to_anchored(const Eigen::Vector3d& p_FinG, const Eigen::Matrix3d& R_GtoA,
+                                   const Eigen::Vector3d& p_AinG, const CameraInfo& anchor_cam,
+                                   Eigen::Matrix3d* dl_dpf, Eigen::Matrix<double, 3, 6>* dl_danchor);
+
+/// Anchor change (OpenVINS's change_anchor): the same point re-expressed in
+/// a new anchor camera b of the pose B,
+///   λ_B = g(λ_A, A, B) = global_to_anchored(anchored_to_global(λ_A, A), B).
+/// J (3×15) is its Jacobian w.r.t. the errors [λ̃_A, δθ_A, δp_A, δθ_B, δp_B]:
+///   J = [G_f F_λ, G_f F_A, G_B]  with F = ∂p_FinG/∂(λ_A, A), G = ∂λ_B/∂(p_FinG, B).
+/// Returns λ_B (z of the point in camera b must be > 0: the caller checks).
+Eigen::Vector3d change_anchor(const Eigen::Vector3d& lambda_A, const Eigen::Matrix3d& R_GtoA,
+                              const Eigen::Vector3d& p_AinG, const CameraInfo& cam_a, const Eigen::Matrix3d& R_GtoB,
+                              const Eigen::Vector3d& p_BinG, const CameraInfo& cam_b,
+                              Eigen::Matrix<double, 3, 15>* J);
 
 }  // namespace estimator
 }  // namespace vimot

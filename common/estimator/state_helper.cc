@@ -307,6 +307,40 @@ bool StateHelper::initialize(State& state, const TypePtr& new_var, const std::ve
   return true;
 }
 
+void StateHelper::transform_variable(State& state, const TypePtr& var, const std::vector<TypePtr>& order,
+                                     const Eigen::MatrixXd& J) {
+  std::vector<std::pair<int, int>> blocks;
+  int n = 0;
+  if (!var || var->id() < 0 || !blocks_of(order, &blocks, &n)) {
+    throw std::invalid_argument("StateHelper::transform_variable: variable not in state");
+  }
+  if (std::find(order.begin(), order.end(), var) == order.end()) {
+    throw std::invalid_argument("StateHelper::transform_variable: order must contain the variable");
+  }
+  const int sz = var->size();
+  if (J.rows() != sz || J.cols() != n) {
+    throw std::invalid_argument("StateHelper::transform_variable: J must be " + std::to_string(sz) + "x" +
+                                std::to_string(n));
+  }
+  Eigen::MatrixXd& P = state.cov_;
+  Eigen::MatrixXd row = Eigen::MatrixXd::Zero(sz, P.cols());  // J P_order,:
+  int c = 0;
+  for (const auto& b : blocks) {
+    row.noalias() += J.middleCols(c, b.second) * P.middleRows(b.first, b.second);
+    c += b.second;
+  }
+  Eigen::MatrixXd P_vv = Eigen::MatrixXd::Zero(sz, sz);  // J P_order,order Jᵀ
+  c = 0;
+  for (const auto& b : blocks) {
+    P_vv.noalias() += row.middleCols(b.first, b.second) * J.middleCols(c, b.second).transpose();
+    c += b.second;
+  }
+  const int id = var->id();
+  P.middleRows(id, sz) = row;
+  P.middleCols(id, sz) = row.transpose();
+  P.block(id, id, sz, sz) = 0.5 * (P_vv + P_vv.transpose());
+}
+
 void StateHelper::augment_clone(State& state, int64_t utime) {
   if (state.clones_.count(utime) != 0) {
     throw std::invalid_argument("StateHelper::augment_clone: a clone at utime " + std::to_string(utime) +

@@ -86,6 +86,15 @@ class StateHelper {
                          Eigen::MatrixXd H_R, Eigen::MatrixXd H_L, Eigen::VectorXd res, double noise_sigma,
                          double chi2_multiplier);
 
+  /// Linear change of variables of `var` (e.g. a landmark's anchor change):
+  /// its error becomes x̃_var' = J x̃_order (J: var.size() × total size of
+  /// `order`, which contains var); every other error is unchanged. Hence
+  /// P ← T P Tᵀ with T the identity but for var's rows, which are J:
+  ///   P_var,: ← J P_order,: ,   P_var,var ← J P_order,order Jᵀ.
+  /// O(N · size(order)). The caller sets var's new value and FEJ.
+  static void transform_variable(State& state, const TypePtr& var, const std::vector<TypePtr>& order,
+                                 const Eigen::MatrixXd& J);
+
   /// Clones the IMU pose at the state time as the newest window pose.
   static void augment_clone(State& state, int64_t utime);
 

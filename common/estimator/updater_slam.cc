@@ -132,6 +132,44 @@ void UpdaterSlam::update(State& state, const std::map<int64_t, Feature>& current
   StateHelper::ekf_update(state, layout.order(), H, r, Eigen::MatrixXd::Identity(rows, rows));
 }
 
+int UpdaterSlam::change_anchors(State& state, int64_t marg_utime) const {
+  if (state.clones().empty()) return 0;
+  const int64_t t_new = state.clones().rbegin()->first;
+  if (t_new == marg_utime) return 0;
+  const auto B = state.clone_at(t_new);
+  const bool fej = state.options().use_fej;
+  int count = 0;
+  for (const auto& kv : state.slam_features()) {
+    const auto& lm = kv.second;
+    if (lm->representation() != LandmarkRepresentation::kAnchoredInverseDepth || lm->should_marginalize ||
+        lm->anchor_utime != marg_utime) {
+      continue;
+    }
+    const auto A = state.clone_at(lm->anchor_utime);
+    if (!A || lm->anchor_camera < 0 || lm->anchor_camera >= static_cast<int>(cameras_.size())) {
+      lm->should_marginalize = true;
+      continue;
+    }
+    const CameraInfo& cam = cameras_[lm->anchor_camera];
+    Eigen::Matrix<double, 3, 15> J;
+    const Eigen::Vector3d value = change_anchor(lm->value(), A->Rot(), A->pos(), cam, B->Rot(), B->pos(), cam,
+                                                fej ? nullptr : &J);
+    const Eigen::Vector3d value_fej = change_anchor(lm->fej(), A->Rot_fej(), A->pos_fej(), cam, B->Rot_fej(),
+                                                    B->pos_fej(), cam, fej ? &J : nullptr);
+    if (!(value(2) > 0.0) || !(value_fej(2) > 0.0) || !value.allFinite() || !value_fej.allFinite() ||
+        !J.allFinite()) {
+      lm->should_marginalize = true;
+      continue;
+    }
+    StateHelper::transform_variable(state, lm, {lm, A, B}, J);
+    lm->set_value(value);
+    lm->set_fej(value_fej);
+    lm->anchor_utime = t_new;
+    ++count;
+  }
+  return count;
+}
+
 std::vector<int64_t> UpdaterSlam::delayed_initialize(State& state, std::vector<std::shared_ptr<Feature>> features,
                                                      UpdateStats* stats) const {
   std::vector<int64_t> added;

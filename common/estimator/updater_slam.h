@@ -1,8 +1,8 @@
 #pragma once
 // SLAM features: landmarks kept in the state, updated with every new
 // observation, initialised with delayed initialisation once a track spans
-// the window, marginalised when their track ends (or, anchored inverse
-// depth, when the anchor clone leaves the window).
+// the window, marginalised when their track ends. An anchored landmark
+// moves to the newest clone before its anchor clone leaves the window.
 //
 // Representations (types.h LandmarkRepresentation):
 //   kGlobalXyz: p_FinG. No anchor; the default.
@@ -69,6 +69,15 @@ class UpdaterSlam {
   /// that entered the state.
   std::vector<int64_t> delayed_initialize(State& state, std::vector<std::shared_ptr<Feature>> features,
                                           UpdateStats* stats) const;
+
+  /// Anchor change before the clone at `marg_utime` leaves the window
+  /// (OpenVINS's change_anchors): every anchored landmark anchored there and
+  /// not flagged moves to the newest clone, same camera, with
+  /// measurement_model.h change_anchor and StateHelper::transform_variable
+  /// (Jacobian at the FEJ values if use_fej, as the measurement Jacobians).
+  /// A landmark whose depth in the new anchor is not positive is flagged for
+  /// marginalisation instead. Returns the number of landmarks re-anchored.
+  int change_anchors(State& state, int64_t marg_utime) const;
 
   const SlamOptions& options() const { return options_; }
 

@@ -398,14 +398,7 @@ void VioEstimator::process_frame(const CameraFrame& frame) {
   last_timing_.slam_init_ms = ms_since(t0);
 
   t0 = Clock::now();
-  if (window_full) {
-    for (const auto& kv : st.slam_features()) {
-      if (kv.second->representation() == LandmarkRepresentation::kAnchoredInverseDepth &&
-          kv.second->anchor_utime == marg_t) {
-        kv.second->should_marginalize = true;
-      }
-    }
-  }
+  if (window_full) slam_.change_anchors(st, marg_t);
   stats.slam_marginalized = StateHelper::marginalize_flagged_slam(st);
   StateHelper::marginalize_old_clones(st);
   database_.clean_older_than(st.oldest_clone_utime());

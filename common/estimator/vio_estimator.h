@@ -10,8 +10,9 @@
 //   feature database; MSCKF update with tracks that ended before t and, once
 //   the window is full, tracks seen at the clone about to leave (those seen
 //   in >= num_clones frames become SLAM candidates if slots are free); SLAM
-//   update; SLAM delayed initialisation; marginalise lost SLAM landmarks and
-//   the oldest clone; divergence check.
+//   update; SLAM delayed initialisation; anchor change of the anchored
+//   landmarks at the leaving clone; marginalise lost SLAM landmarks and the
+//   oldest clone; divergence check.
 
 #include <Eigen/Core>
 #include <cstdint>

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <Eigen/Eigenvalues>
 #include <functional>
 #include <memory>
 #include <random>
@@ -109,6 +110,122 @@ TEST_CASE("Anchored inverse-depth Jacobians w.r.t. lambda and anchor pose", "[me
                                 nullptr, nullptr);
     };
     CHECK((J_a.col(i) - (f(d) - f(-d)) / (2 * eps)).norm() < 1e-6);
+  }
+}
+
+TEST_CASE("Anchor change: value and finite-difference Jacobian", "[measurement][slam]") {
+  const CameraInfo cam_a = test_camera(0), cam_b = test_camera(1);
+  const ClonePose A = test_pose(1), B = test_pose(4);
+  const Eigen::Vector3d lambda(0.1, -0.05, 0.2);
+  // global_to_anchored's own Jacobians.
+  {
+    const Eigen::Vector3d p = anchored_to_global(lambda, A.R_GtoI, A.p_IinG, cam_a, nullptr, nullptr);
+    Eigen::Matrix3d G_f;
+    Eigen::Matrix<double, 3, 6> G_b;
+    global_to_anchored(p, B.R_GtoI, B.p_IinG, cam_b, &G_f, &G_b);
+    const double eps = 1e-6;
+    for (int i = 0; i < 3; ++i) {
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      d(i) = eps;
+      const Eigen::Vector3d num = (global_to_anchored(p + d, B.R_GtoI, B.p_IinG, cam_b) -
+                                   global_to_anchored(p - d, B.R_GtoI, B.p_IinG, cam_b)) /
+                                  (2 * eps);
+      CHECK((G_f.col(i) - num).norm() < 1e-7);
+    }
+  }
+  Eigen::Matrix<double, 3, 15> J;
+  const Eigen::Vector3d lb = change_anchor(lambda, A.R_GtoI, A.p_IinG, cam_a, B.R_GtoI, B.p_IinG, cam_b, &J);
+  // Same point.
+  CHECK((anchored_to_global(lb, B.R_GtoI, B.p_IinG, cam_b, nullptr, nullptr) -
+         anchored_to_global(lambda, A.R_GtoI, A.p_IinG, cam_a, nullptr, nullptr))
+            .norm() < 1e-12);
+  // Error order [λ̃_A, δθ_A, δp_A, δθ_B, δp_B] with the left error of the poses.
+  auto f = [&](const Eigen::Matrix<double, 15, 1>& e) {
+    return change_anchor(lambda + e.head<3>(), exp_so3(-e.segment<3>(3)) * A.R_GtoI, A.p_IinG + e.segment<3>(6),
+                         cam_a, exp_so3(-e.segment<3>(9)) * B.R_GtoI, B.p_IinG + e.segment<3>(12), cam_b, nullptr);
+  };
+  const double eps = 1e-6;
+  for (int i = 0; i < 15; ++i) {
+    Eigen::Matrix<double, 15, 1> d = Eigen::Matrix<double, 15, 1>::Zero();
+    d(i) = eps;
+    const Eigen::Vector3d num = (f(d) - f(-d)) / (2 * eps);
+    INFO("column " << i);
+    CHECK((J.col(i) - num).norm() < 1e-6 * std::max(1.0, num.norm()));
+  }
+  // Moving both anchors together (a global translation) leaves λ_B unchanged.
+  CHECK((J.middleCols<3>(6) + J.middleCols<3>(12)).cwiseAbs().maxCoeff() < 1e-12);
+}
+
+TEST_CASE("Re-anchoring keeps the landmark's global position and covariance", "[measurement][slam]") {
+  const std::vector<CameraInfo> cams = {test_camera(0), test_camera(1)};
+  const std::vector<ClonePose> poses = {test_pose(0), test_pose(1), test_pose(2), test_pose(3)};
+  for (bool use_fej : {false, true}) {
+    State st = make_state(poses, use_fej);
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n01;
+    auto lm = std::make_shared<Landmark>(7, LandmarkRepresentation::kAnchoredInverseDepth);
+    const ClonePose& a = poses[0];
+    const Eigen::Vector3d p_FinG =
+        a.p_IinG + a.R_GtoI.transpose() * (cams[1].R_ItoC.transpose() * (Eigen::Vector3d(0.4, 0.2, 5.0) - cams[1].p_IinC));
+    lm->anchor_utime = 0;
+    lm->anchor_camera = 1;
+    lm->set_value(global_to_anchored(p_FinG, a.R_GtoI, a.p_IinG, cams[1]));
+    lm->set_fej(lm->value() + Eigen::Vector3d(0.001, -0.002, 0.003));
+    StateHelper::add_variable(st, lm, Eigen::Matrix3d::Identity() * 1e-4);
+    StateHelper::register_slam_feature(st, lm);
+    const int N = st.cov_size();
+    Eigen::MatrixXd M(N, N);
+    for (int i = 0; i < N; ++i) {
+      for (int j = 0; j < N; ++j) M(i, j) = n01(rng);
+    }
+    // Correlate everything with one EKF update over all variables.
+    REQUIRE(StateHelper::ekf_update(st, st.variables(), M.topRows(6), Eigen::VectorXd::Zero(6),
+                                    Eigen::MatrixXd::Identity(6, 6) * 1e-3));
+    const auto A = st.clone_at(0);
+    const auto B = st.clones().rbegin()->second;
+    const Eigen::MatrixXd P_before = st.cov();
+    // Global point and its Jacobian w.r.t. [λ, A] before the change.
+    Eigen::Matrix3d F_l;
+    Eigen::Matrix<double, 3, 6> F_a;
+    const Eigen::Vector3d p_before = anchored_to_global(lm->value(), A->Rot(), A->pos(), cams[1], &F_l, &F_a);
+    const Eigen::Vector3d p_fej_before = anchored_to_global(lm->fej(), A->Rot_fej(), A->pos_fej(), cams[1], nullptr, nullptr);
+    Eigen::MatrixXd T_before = Eigen::MatrixXd::Zero(3, N);
+    T_before.middleCols(lm->id(), 3) = F_l;
+    T_before.middleCols(A->id(), 6) = F_a;
+    const Eigen::MatrixXd C_before = T_before * P_before;  // cov(p_FinG, x)
+
+    UpdaterSlam slam(SlamOptions{}, TriangulationOptions{}, cams);
+    REQUIRE(slam.change_anchors(st, 0) == 1);
+    CHECK(lm->anchor_utime == st.clones().rbegin()->first);
+    CHECK(lm->anchor_camera == 1);
+    Eigen::Matrix3d G_l;
+    Eigen::Matrix<double, 3, 6> G_b;
+    const Eigen::Vector3d p_after = anchored_to_global(lm->value(), B->Rot(), B->pos(), cams[1], &G_l, &G_b);
+    CHECK((p_after - p_before).norm() < 1e-12);
+    CHECK((anchored_to_global(lm->fej(), B->Rot_fej(), B->pos_fej(), cams[1], nullptr, nullptr) - p_fej_before)
+              .norm() < 1e-12);
+    const Eigen::MatrixXd& P_after = st.cov();
+    // Only the landmark's rows and columns change.
+    Eigen::MatrixXd D = P_after - P_before;
+    D.middleRows(lm->id(), 3).setZero();
+    D.middleCols(lm->id(), 3).setZero();
+    CHECK(D.cwiseAbs().maxCoeff() == 0.0);
+    CHECK((P_after - P_after.transpose()).cwiseAbs().maxCoeff() < 1e-18);
+    CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(P_after).eigenvalues().minCoeff() > -1e-15);
+    if (!use_fej) {
+      // Linearised at the estimate, the global point's covariance and its
+      // correlations with the rest of the state are unchanged.
+      Eigen::MatrixXd T_after = Eigen::MatrixXd::Zero(3, N);
+      T_after.middleCols(lm->id(), 3) = G_l;
+      T_after.middleCols(B->id(), 6) = G_b;
+      const Eigen::MatrixXd C_after = T_after * P_after;
+      const double scale = C_before.cwiseAbs().maxCoeff();
+      // cov(p_FinG, every other variable) (the landmark's columns are a new variable).
+      Eigen::MatrixXd dC = C_after - C_before;
+      dC.middleCols(lm->id(), 3).setZero();
+      CHECK(dC.cwiseAbs().maxCoeff() < 1e-9 * scale);
+      CHECK((C_after * T_after.transpose() - C_before * T_before.transpose()).cwiseAbs().maxCoeff() < 1e-9 * scale);
+    }
   }
 }
 

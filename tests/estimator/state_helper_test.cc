@@ -305,3 +305,28 @@ TEST_CASE("Covariance propagation touches only the evolving blocks", "[state_hel
   const Eigen::MatrixXd ref = F * P * F.transpose() + Qf;
   CHECK((ts.st.cov() - ref).cwiseAbs().maxCoeff() < 1e-13);
 }
+
+TEST_CASE("transform_variable equals T P Tᵀ with T = I but for the variable's rows", "[state_helper]") {
+  std::mt19937 rng(5);
+  const int N = 33;
+  const Eigen::MatrixXd P = random_spd(N, rng);
+  TestState ts;
+  build(&ts, P);
+  // The last vector (id 30) becomes J [vec, pose1, pose2]: as an anchor change.
+  const auto vec = ts.vars[4];
+  const std::vector<TypePtr> order = {vec, ts.vars[1], ts.vars[2]};
+  const Eigen::MatrixXd J = random_matrix(3, 15, rng);
+  Eigen::MatrixXd T = Eigen::MatrixXd::Identity(N, N);
+  T.middleRows(vec->id(), 3).setZero();
+  T.block(vec->id(), vec->id(), 3, 3) = J.leftCols(3);
+  T.block(vec->id(), ts.vars[1]->id(), 3, 6) = J.middleCols(3, 6);
+  T.block(vec->id(), ts.vars[2]->id(), 3, 6) = J.rightCols(6);
+  const Eigen::MatrixXd P_ref = T * P * T.transpose();
+  const auto values = ts.vars[3]->value();
+  StateHelper::transform_variable(ts.st, vec, order, J);
+  CHECK((ts.st.cov() - P_ref).cwiseAbs().maxCoeff() < 1e-14);
+  CHECK(ts.vars[3]->value() == values);
+  CHECK_THROWS_AS(StateHelper::transform_variable(ts.st, vec, {ts.vars[1]}, J.middleCols(3, 6)),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(StateHelper::transform_variable(ts.st, vec, order, J.leftCols(9)), std::invalid_argument);
+}
