@@ -39,6 +39,8 @@
 namespace vimot {
 namespace estimator {
 
+class VioExtension;
+
 using Matrix15d = Eigen::Matrix<double, 15, 15>;
 
 /// Continuous-time IMU noise densities (defaults: ADIS16448 as in EuRoC).
@@ -99,6 +101,11 @@ class Propagator {
   /// Propagates mean and covariance of the IMU from state.utime() to utime
   /// (> state.utime()); afterwards the IMU FEJ equals the new estimate.
   PropagationReport propagate(State& state, int64_t utime);
+
+  /// As propagate(), but variables of `extension` (vio_extension.h) are
+  /// propagated jointly with the IMU (its Φ, Q over [imu; extra]); with
+  /// extension == nullptr exactly propagate().
+  PropagationReport propagate(State& state, int64_t utime, VioExtension* extension);
 
   /// propagate() then clones the new IMU pose into the window at utime.
   PropagationReport propagate_and_clone(State& state, int64_t utime);

@@ -240,6 +240,7 @@ void VioEstimator::reset() {
   state_ = std::make_unique<State>(options_.state);
   database_.clear();
   static_init_.clear();
+  if (extension_) extension_->reset();
   initialized_ = false;
   diverged_ = false;
 }
@@ -303,13 +304,21 @@ FrameStatus VioEstimator::feed_camera(const CameraFrame& frame) {
     StateHelper::augment_clone(st, frame.utime);
     last_propagation_ = PropagationReport{};
     last_propagation_.ok = true;
-  } else {
+  } else if (extension_ == nullptr) {
     last_propagation_ = propagator_.propagate_and_clone(st, frame.utime);
     if (!last_propagation_.ok) {
       ++frames_dropped_;
       return FrameStatus::kNoImu;
     }
+  } else {
+    last_propagation_ = propagator_.propagate(st, frame.utime, extension_);
+    if (!last_propagation_.ok) {
+      ++frames_dropped_;
+      return FrameStatus::kNoImu;
+    }
+    StateHelper::augment_clone(st, frame.utime);
   }
+  if (extension_) extension_->on_clone_added(st, frame.utime);
   last_timing_.propagate_ms = ms_since(t_start);
   try {
     process_frame(frame);
@@ -330,10 +339,14 @@ void VioEstimator::process_frame(const CameraFrame& frame) {
 
   // Sort observations: landmarks in the state vs tracks in the database.
   std::map<int64_t, Feature> slam_now;
+  std::vector<FeatureObservation> target_obs;
   const int num_cams = options_.use_stereo ? static_cast<int>(cameras_.size()) : 1;
   for (const auto& o : frame.observations) {
     if (o.is_target) {
       ++target_obs_ignored_;
+      if (extension_ && o.camera_id >= 0 && o.camera_id < num_cams && o.normalized.allFinite()) {
+        target_obs.push_back(o);
+      }
       continue;
     }
     if (o.camera_id < 0 || o.camera_id >= num_cams || !o.normalized.allFinite()) {
@@ -397,9 +410,18 @@ void VioEstimator::process_frame(const CameraFrame& frame) {
   for (const auto& f : slam_init) database_.remove(f->feature_id);
   last_timing_.slam_init_ms = ms_since(t0);
 
+  // Extension update (target observations) after the static updates, before
+  // the oldest clone leaves.
+  if (extension_) extension_->update(st, t, target_obs);
+
   t0 = Clock::now();
   if (window_full) slam_.change_anchors(st, marg_t);
   stats.slam_marginalized = StateHelper::marginalize_flagged_slam(st);
+  if (extension_) {
+    const int n_leaving = static_cast<int>(st.clones().size()) - st.options().max_clones;
+    auto it = st.clones().begin();
+    for (int i = 0; i < n_leaving && it != st.clones().end(); ++i, ++it) extension_->on_clone_marginalized(st, it->first);
+  }
   StateHelper::marginalize_old_clones(st);
   database_.clean_older_than(st.oldest_clone_utime());
   propagator_.clean_older_than(t);

@@ -31,6 +31,7 @@
 #include "common/estimator/updater_common.h"
 #include "common/estimator/updater_msckf.h"
 #include "common/estimator/updater_slam.h"
+#include "common/estimator/vio_extension.h"
 #include "common/types/sensor_data.h"
 
 namespace vimot {
@@ -149,6 +150,12 @@ class VioEstimator {
   const State& state() const { return *state_; }
   /// For extensions (target filter) that add variables to the same state.
   State& mutable_state() { return *state_; }
+  /// Attaches an extension (not owned; nullptr detaches). See
+  /// vio_extension.h for the calls it gets. Without one the estimator's
+  /// behaviour is unchanged; with one, is_target observations go to it
+  /// (they are still counted in target_observations_ignored()).
+  void set_extension(VioExtension* extension) { extension_ = extension; }
+  VioExtension* extension() const { return extension_; }
   const Propagator& propagator() const { return propagator_; }
   const std::vector<CameraInfo>& cameras() const { return cameras_; }
   const VioOptions& options() const { return options_; }
@@ -175,6 +182,7 @@ class VioEstimator {
   UpdaterSlam slam_;
   StaticInitializer static_init_;
   FeatureDatabase database_;
+  VioExtension* extension_{nullptr};
 
   bool initialized_{false};
   bool diverged_{false};

@@ -1,0 +1,163 @@
+#pragma once
+// Joint robot + target filter (Eckenhoff et al., "Schmidt-EKF-based
+// Visual-Inertial Moving Object Tracking", Sec. III–V) on top of the
+// VioEstimator through its extension hooks (common/estimator/vio_extension.h).
+//
+// State added to the estimator's State (same covariance):
+//   * TargetState x_T = [q_RtoT, p_TinR, v_TinT, w_TinT] (value 13, error 12,
+//     R = G global or R = I local; the error convention of target_types.h),
+//     propagated jointly with the IMU over every camera interval with
+//     target::propagate_target + joint_transition (local: the target is
+//     correlated with the IMU through Φ_TI and Q_TI);
+//   * target pose clones [q_RtoT, p_TinR] at the IMU clone times, added with
+//     the IMU clone and marginalised with it. A local clone is the target
+//     pose relative to the IMU *at the clone time*, i.e. relative to its IMU
+//     clone (the paper's local clones).
+// Static-feature updates (MSCKF, SLAM) update the whole state, so the target
+// is corrected through its correlations with the robot.
+//
+// Target update (after the static updates of a frame), MSCKF-style: a target
+// point track is used when it is lost or is seen at the IMU clone about to
+// leave the window; its observations at clone times are kept; the point
+// p_FinT is triangulated in the target frame from the camera poses in T
+// (IMU clone ∘ target clone); the stacked whitened system
+//   r = H_x x̃ + H_f p̃_FinT + n   (H_x over target clones; global also IMU clones)
+// is projected onto the left nullspace of H_f and gated by χ²
+// (rᵀ(H P Hᵀ + I)⁻¹ r < chi2_multiplier · χ²_0.95(dof)). Modes:
+//   kOff   no target update (the target is only predicted),
+//   kEkf   StateHelper::ekf_update on everything (tightly coupled),
+//   kSkf   StateHelper::schmidt_update with every non-target variable (IMU,
+//          IMU clones, SLAM landmarks) as nuisance: robot estimate and P_RR
+//          are never changed by a target update.
+// Initialisation (simulation): from the ground truth at the first frame with
+// target observations (set_ground_truth() before feed_camera), with the
+// prior init_sigmas (uncorrelated with the robot). A front-end initialiser
+// comes later.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/estimator/feature_database.h"
+#include "common/estimator/triangulation.h"
+#include "common/estimator/vio_estimator.h"
+#include "common/estimator/vio_extension.h"
+#include "common/target/target_model.h"
+#include "common/target/target_types.h"
+#include "common/types/ground_truth.h"
+
+namespace vimot {
+namespace target {
+
+/// Target state variable: value [q_RtoT (JPL); p_TinR; v_TinT; w_TinT] (13),
+/// error [δθ δp δv δw] (12). pose() (rows 0..5), v(), w() are parts.
+class TargetState : public estimator::Type {
+ public:
+  TargetState();
+  void set_local_id(int new_id) override;
+  void update(const Eigen::VectorXd& dx) override;
+  void set_value(const Eigen::VectorXd& value) override;
+  void set_fej(const Eigen::VectorXd& fej) override;
+  std::shared_ptr<estimator::Type> clone_type() const override;
+  bool contains(const estimator::Type* other) const override;
+
+  TargetValue get() const;
+  std::shared_ptr<estimator::PoseJPL> pose() const { return pose_; }
+  std::shared_ptr<estimator::Vec> v() const { return v_; }
+  std::shared_ptr<estimator::Vec> w() const { return w_; }
+
+ private:
+  std::shared_ptr<estimator::PoseJPL> pose_;
+  std::shared_ptr<estimator::Vec> v_;
+  std::shared_ptr<estimator::Vec> w_;
+};
+
+enum class TargetUpdateMode { kOff, kEkf, kSkf };
+const char* to_string(TargetUpdateMode mode);
+
+struct TargetInitSigmas {
+  double theta{0.01};  // rad
+  double p{0.01};      // m
+  double v{0.05};      // m/s
+  double w{0.01};      // rad/s
+};
+
+struct TargetFilterOptions {
+  TargetUpdateMode mode{TargetUpdateMode::kSkf};
+  TargetRepresentation representation{TargetRepresentation::kLocal};
+  double sigma_t{0.05};   // target noise density (v: m/s²/√Hz, w: rad/s²/√Hz)
+  bool planar{true};      // only v_x, v_y, w_z driven (paper Sec. IV)
+  TargetInitSigmas init_sigmas;
+  double chi2_multiplier{1.0};
+  int min_clone_times{2};
+  estimator::TriangulationOptions triangulation;
+
+  TargetNoise noise() const;
+};
+
+struct TargetUpdateStats {
+  int64_t updates{0};              // frames with a target update applied
+  int64_t tracks_used{0};
+  int64_t rejected_short{0};
+  int64_t rejected_triangulation{0};
+  int64_t rejected_chi2{0};
+  int64_t rows{0};
+};
+
+class TargetFilter : public estimator::VioExtension {
+ public:
+  /// Attaches itself to `estimator` (which must outlive it); detaches in the
+  /// destructor.
+  TargetFilter(estimator::VioEstimator& estimator, const TargetFilterOptions& options);
+  ~TargetFilter() override;
+  TargetFilter(const TargetFilter&) = delete;
+  TargetFilter& operator=(const TargetFilter&) = delete;
+
+  /// Ground truth for the initialisation (used if its utime is the frame's).
+  void set_ground_truth(const GroundTruth& truth) { truth_ = truth; }
+
+  const TargetFilterOptions& options() const { return options_; }
+  bool initialized() const { return static_cast<bool>(target_); }
+  /// The target variable (nullptr before initialisation).
+  const std::shared_ptr<TargetState>& target() const { return target_; }
+  const std::map<int64_t, std::shared_ptr<estimator::PoseJPL>>& clones() const { return clones_; }
+  TargetValue value() const;
+  /// Covariance (12×12) of the target error.
+  Matrix12d covariance() const;
+  /// Target position in the current IMU frame and its covariance (3×3)
+  /// (local: p_TinI itself; global: R_GtoI (p_TinG − p_IinG), covariance by
+  /// the Jacobian w.r.t. [δθ_I δp_I δp_T]).
+  Eigen::Vector3d p_TinI(Eigen::Matrix3d* cov = nullptr) const;
+  const TargetUpdateStats& stats() const { return stats_; }
+
+  // estimator::VioExtension
+  bool propagate_jointly(const estimator::State& state, const estimator::ImuValue& x0, const estimator::ImuValue& x1,
+                         const estimator::Matrix15d& Phi_II, const estimator::Matrix15d& Q_II, int64_t t0, int64_t t1,
+                         std::vector<estimator::TypePtr>* order, Eigen::MatrixXd* Phi, Eigen::MatrixXd* Q) override;
+  void commit_propagation(estimator::State& state) override;
+  void on_clone_added(estimator::State& state, int64_t utime) override;
+  void on_clone_marginalized(estimator::State& state, int64_t utime) override;
+  void update(estimator::State& state, int64_t utime,
+              const std::vector<FeatureObservation>& target_observations) override;
+  void reset() override;
+
+ private:
+  bool initialize_from_truth(estimator::State& state, int64_t utime);
+  void update_tracks(estimator::State& state, std::vector<std::shared_ptr<estimator::Feature>> tracks);
+
+  estimator::VioEstimator& estimator_;
+  TargetFilterOptions options_;
+  TargetNoise noise_;
+  std::shared_ptr<TargetState> target_;
+  std::map<int64_t, std::shared_ptr<estimator::PoseJPL>> clones_;
+  std::optional<TargetValue> pending_;
+  estimator::FeatureDatabase tracks_;
+  std::optional<GroundTruth> truth_;
+  TargetUpdateStats stats_;
+};
+
+}  // namespace target
+}  // namespace vimot
