@@ -211,6 +211,7 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
     if (obs.empty() || !initialize_from_truth(state, utime)) return;
   }
   if (options_.mode == TargetUpdateMode::kOff) return;
+  stats_.obs_received += static_cast<int64_t>(obs.size());
   if (clones_.count(utime) != 0) {
     for (const auto& o : obs) tracks_.add(utime, o.feature_id, o.camera_id, o.normalized);
   }
@@ -301,6 +302,7 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
       ++stats_.rejected_triangulation;
       continue;
     }
+    const Eigen::VectorXd r_raw = r;
     estimator::nullspace_project_inplace(H_f, H_x, r);
     if (r.size() == 0) {
       ++stats_.rejected_triangulation;
@@ -314,6 +316,10 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
       continue;
     }
     ++stats_.tracks_used;
+    stats_.obs_used += m;
+    stats_.residual_sum += r_raw.sum();
+    stats_.residual_sq_sum += r_raw.squaredNorm();
+    stats_.residual_count += r_raw.size();
     total_rows += static_cast<int>(r.size());
     Hs.push_back(std::move(H_x));
     rs.push_back(std::move(r));

@@ -105,6 +105,13 @@ struct TargetUpdateStats {
   int64_t rejected_triangulation{0};
   int64_t rejected_chi2{0};
   int64_t rows{0};
+  int64_t obs_received{0};         // target observations handed to update()
+  int64_t obs_used{0};             // observations in tracks that passed the gate
+  // Whitened raw residuals (before the nullspace projection) of used tracks:
+  // sum, sum of squares, count (diagnostics: mean should be ≈ 0).
+  double residual_sum{0.0};
+  double residual_sq_sum{0.0};
+  int64_t residual_count{0};
 };
 
 class TargetFilter : public estimator::VioExtension {
