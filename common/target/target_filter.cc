@@ -100,6 +100,10 @@ TargetFilter::TargetFilter(estimator::VioEstimator& estimator, const TargetFilte
   if (!noise_.valid() || !(options_.sigma_t >= 0.0)) throw std::invalid_argument("TargetFilterOptions: bad sigma_t");
   if (!(options_.chi2_multiplier > 0.0)) throw std::invalid_argument("TargetFilterOptions: chi2_multiplier must be > 0");
   if (options_.min_clone_times < 2) throw std::invalid_argument("TargetFilterOptions: min_clone_times must be >= 2");
+  if (options_.max_target_points < 0 || options_.point_init_clone_times < 2 || options_.point_max_lost_frames < 1) {
+    throw std::invalid_argument("TargetFilterOptions: need max_target_points >= 0, point_init_clone_times >= 2 and "
+                                "point_max_lost_frames >= 1");
+  }
   estimator_.set_extension(this);
 }
 
@@ -112,6 +116,8 @@ void TargetFilter::reset() {
   clones_.clear();
   pending_.reset();
   tracks_.clear();
+  points_.clear();
+  frame_ = 0;
 }
 
 TargetValue TargetFilter::value() const { return target_ ? target_->get() : TargetValue(); }
@@ -211,10 +217,28 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
     if (obs.empty() || !initialize_from_truth(state, utime)) return;
   }
   if (options_.mode == TargetUpdateMode::kOff) return;
+  ++frame_;
   stats_.obs_received += static_cast<int64_t>(obs.size());
-  if (clones_.count(utime) != 0) {
-    for (const auto& o : obs) tracks_.add(utime, o.feature_id, o.camera_id, o.normalized);
+  const bool at_clone = clones_.count(utime) != 0;
+  std::vector<FeatureObservation> point_obs;
+  for (const auto& o : obs) {
+    if (points_.count(o.feature_id) != 0) {
+      point_obs.push_back(o);
+    } else if (at_clone) {
+      tracks_.add(utime, o.feature_id, o.camera_id, o.normalized);
+    }
   }
+  // 1. In-state target points: update with their current observations.
+  update_points(state, point_obs);
+  // 2. Points not updated for a while leave the state.
+  std::vector<int64_t> lost;
+  for (const auto& kv : points_) {
+    if (frame_ - kv.second.last_updated_frame >= options_.point_max_lost_frames) lost.push_back(kv.first);
+  }
+  for (const int64_t id : lost) marginalize_point(state, id);
+  // 3. Delayed initialisation of long tracks still seen now.
+  if (at_clone && options_.max_target_points > 0) initialize_points(state, utime);
+  // 4. MSCKF-style update of the other tracks.
   std::vector<std::shared_ptr<estimator::Feature>> use = tracks_.lost_before(utime);
   if (static_cast<int>(state.clones().size()) > state.options().max_clones) {
     for (const auto& f : tracks_.observed_at(state.oldest_clone_utime())) {
@@ -225,16 +249,13 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
   update_tracks(state, std::move(use));
 }
 
-void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estimator::Feature>> tracks) {
-  if (tracks.empty()) return;
+estimator::ClonePoses TargetFilter::poses_in_target(const State& state, std::set<int64_t>* times) const {
   const bool global = options_.representation == TargetRepresentation::kGlobal;
-  const auto& cameras = estimator_.cameras();
-  std::set<int64_t> times;
   estimator::ClonePoses poses_in_T;  // IMU pose at each clone time in the target frame
   for (const auto& kv : clones_) {
     const auto imu_clone = state.clone_at(kv.first);
     if (!imu_clone) continue;
-    times.insert(kv.first);
+    times->insert(kv.first);
     const Eigen::Matrix3d R_RtoT = kv.second->Rot();
     const Eigen::Vector3d p_TinR = kv.second->pos();
     estimator::ClonePose cp;
@@ -247,6 +268,236 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
     }
     poses_in_T[kv.first] = cp;
   }
+  return poses_in_T;
+}
+
+std::vector<TypePtr> TargetFilter::nuisance_variables(const State& state) const {
+  std::vector<TypePtr> nuisance;
+  for (const auto& v : state.variables()) {
+    if (v == target_) continue;
+    bool active = false;
+    for (const auto& kv : clones_) active = active || kv.second == v;
+    for (const auto& kv : points_) active = active || kv.second.var == v;
+    if (!active) nuisance.push_back(v);
+  }
+  return nuisance;
+}
+
+bool TargetFilter::apply_update(State& state, const std::vector<TypePtr>& order, const Eigen::MatrixXd& H,
+                                const Eigen::VectorXd& r) {
+  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(r.size(), r.size());
+  if (options_.mode == TargetUpdateMode::kEkf) return StateHelper::ekf_update(state, order, H, r, R);
+  return StateHelper::schmidt_update(state, order, H, r, R, nuisance_variables(state));
+}
+
+void TargetFilter::marginalize_point(State& state, int64_t feature_id) {
+  const auto it = points_.find(feature_id);
+  if (it == points_.end()) return;
+  StateHelper::marginalize(state, it->second.var);
+  points_.erase(it);
+  ++stats_.points_marginalized;
+}
+
+void TargetFilter::update_points(State& state, const std::vector<FeatureObservation>& obs) {
+  if (obs.empty()) return;
+  const bool global = options_.representation == TargetRepresentation::kGlobal;
+  const auto& cameras = estimator_.cameras();
+  std::map<int64_t, std::vector<const FeatureObservation*>> by_point;
+  for (const auto& o : obs) {
+    if (o.camera_id < 0 || o.camera_id >= static_cast<int>(cameras.size())) continue;
+    by_point[o.feature_id].push_back(&o);
+  }
+  const PoseValue imu_pose{state.imu()->pose()->quat(), state.imu()->pose()->pos()};
+  const PoseValue tgt_pose{target_->pose()->quat(), target_->pose()->pos()};
+  struct Block {
+    TypePtr point;
+    Eigen::MatrixXd H;  // [target pose (6), IMU pose (6, global), point (3)]
+    Eigen::VectorXd r;
+  };
+  std::vector<Block> accepted;
+  int rows = 0;
+  for (const auto& kv : by_point) {
+    TargetPoint& pt = points_.at(kv.first);
+    const Eigen::Vector3d p_FinT = pt.var->value();
+    const int m = static_cast<int>(kv.second.size());
+    const int nx = global ? 15 : 9;
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(2 * m, nx);
+    Eigen::VectorXd r(2 * m);
+    int row = 0;
+    for (const FeatureObservation* o : kv.second) {
+      const estimator::CameraInfo& cam = cameras[static_cast<size_t>(o->camera_id)];
+      const TargetPointPrediction pred =
+          predict_target_point(options_.representation, imu_pose, tgt_pose, p_FinT, CameraExtrinsics{cam.R_ItoC, cam.p_IinC});
+      if (!pred.valid) continue;
+      const Eigen::Matrix2d W = cam.whitening(o->normalized);
+      H.block<2, 6>(row, 0) = W * pred.H_target_pose;
+      if (global) H.block<2, 6>(row, 6) = W * pred.H_imu_pose;
+      H.block<2, 3>(row, nx - 3) = W * pred.H_point;
+      r.segment<2>(row) = W * (o->normalized - pred.z);
+      row += 2;
+    }
+    if (row == 0) continue;
+    H.conservativeResize(row, nx);
+    r.conservativeResize(row);
+    std::vector<TypePtr> order{target_->pose()};
+    if (global) order.push_back(state.imu()->pose());
+    order.push_back(pt.var);
+    Eigen::MatrixXd S = H * StateHelper::marginal_covariance(state, order) * H.transpose();
+    S.diagonal().array() += 1.0;
+    const double chi2 = r.dot(S.llt().solve(r));
+    if (!(chi2 < options_.chi2_multiplier * estimator::chi2_95(static_cast<int>(r.size())))) {
+      ++stats_.points_rejected_chi2;
+      continue;
+    }
+    pt.last_updated_frame = frame_;
+    ++stats_.point_updates;
+    stats_.obs_used += row / 2;
+    rows += row;
+    accepted.push_back(Block{pt.var, std::move(H), std::move(r)});
+  }
+  if (accepted.empty()) return;
+  estimator::ColumnLayout layout;
+  layout.col(target_->pose());
+  if (global) layout.col(state.imu()->pose());
+  for (const auto& b : accepted) layout.col(b.point);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(rows, layout.total());
+  Eigen::VectorXd r(rows);
+  int row = 0;
+  for (const auto& b : accepted) {
+    const int n = static_cast<int>(b.r.size());
+    H.block(row, layout.col(target_->pose()), n, 6) = b.H.leftCols(6);
+    if (global) H.block(row, layout.col(state.imu()->pose()), n, 6) = b.H.middleCols(6, 6);
+    H.block(row, layout.col(b.point), n, 3) = b.H.rightCols(3);
+    r.segment(row, n) = b.r;
+    row += n;
+  }
+  stats_.rows += rows;
+  apply_update(state, layout.order(), H, r);
+}
+
+void TargetFilter::initialize_points(State& state, int64_t utime) {
+  std::vector<std::shared_ptr<estimator::Feature>> cands;
+  for (const auto& f : tracks_.observed_at(utime)) {
+    if (static_cast<int>(f->times().size()) >= options_.point_init_clone_times) cands.push_back(f);
+  }
+  if (cands.empty()) return;
+  // Make room: points not updated at this frame leave first (longest unseen first).
+  int room = options_.max_target_points - static_cast<int>(points_.size());
+  if (room < static_cast<int>(cands.size())) {
+    std::vector<std::pair<int64_t, int64_t>> stale;  // (last updated frame, id)
+    for (const auto& kv : points_) {
+      if (kv.second.last_updated_frame < frame_) stale.emplace_back(kv.second.last_updated_frame, kv.first);
+    }
+    std::sort(stale.begin(), stale.end());
+    for (const auto& s : stale) {
+      if (room >= static_cast<int>(cands.size())) break;
+      marginalize_point(state, s.second);
+      ++room;
+    }
+  }
+  if (room <= 0) return;
+  std::sort(cands.begin(), cands.end(), [](const auto& a, const auto& b) {
+    const int na = a->num_obs(), nb = b->num_obs();
+    return na != nb ? na > nb : a->feature_id < b->feature_id;
+  });
+  const bool global = options_.representation == TargetRepresentation::kGlobal;
+  const auto& cameras = estimator_.cameras();
+  std::set<int64_t> times;
+  const estimator::ClonePoses poses_in_T = poses_in_target(state, &times);
+  const estimator::FeatureTriangulator triangulator(options_.triangulation, cameras);
+  int added = 0;
+  for (auto& f : cands) {
+    if (added >= room) break;
+    f->keep_times(times);
+    if (static_cast<int>(f->times().size()) < options_.point_init_clone_times || !triangulator.triangulate(*f, poses_in_T)) {
+      ++stats_.points_rejected_init;
+      continue;
+    }
+    const Eigen::Vector3d p_FinT = f->p_FinG;
+    estimator::ColumnLayout layout;
+    for (const auto& kv : clones_) {
+      if (times.count(kv.first) == 0) continue;
+      layout.col(kv.second);
+      if (global) layout.col(state.clone_at(kv.first));
+    }
+    const int m = f->num_obs();
+    Eigen::MatrixXd H_R = Eigen::MatrixXd::Zero(2 * m, layout.total());
+    Eigen::MatrixXd H_L = Eigen::MatrixXd::Zero(2 * m, 3);
+    Eigen::VectorXd r(2 * m);
+    bool ok = true;
+    int row = 0;
+    for (const auto& kv : f->obs) {
+      if (kv.first < 0 || kv.first >= static_cast<int>(cameras.size())) {
+        ok = false;
+        break;
+      }
+      const estimator::CameraInfo& cam = cameras[static_cast<size_t>(kv.first)];
+      const CameraExtrinsics ext{cam.R_ItoC, cam.p_IinC};
+      for (const auto& o : kv.second) {
+        const auto tclone = clones_.at(o.utime);
+        const auto iclone = state.clone_at(o.utime);
+        const TargetPointPrediction pred = predict_target_point(
+            options_.representation, PoseValue{iclone->quat(), iclone->pos()}, PoseValue{tclone->quat(), tclone->pos()},
+            p_FinT, ext);
+        if (!pred.valid) ok = false;
+        const Eigen::Matrix2d W = cam.whitening(o.uv);
+        H_R.block<2, 6>(row, layout.col(tclone)) = W * pred.H_target_pose;
+        if (global) H_R.block<2, 6>(row, layout.col(iclone)) = W * pred.H_imu_pose;
+        H_L.block<2, 3>(row, 0) = W * pred.H_point;
+        r.segment<2>(row) = W * (o.uv - pred.z);
+        row += 2;
+      }
+      if (!ok) break;
+    }
+    if (!ok) {
+      ++stats_.points_rejected_init;
+      continue;
+    }
+    auto var = std::make_shared<estimator::Vec>(3);
+    var->set_value(p_FinT);
+    var->set_fej(p_FinT);
+    bool initialized = false;
+    if (options_.mode == TargetUpdateMode::kEkf) {
+      initialized = StateHelper::initialize(state, var, layout.order(), H_R, H_L, r, 1.0, options_.chi2_multiplier);
+    } else {
+      // StateHelper::initialize with a Schmidt update of the remaining rows
+      // (its EKF update would change the robot).
+      estimator::givens_triangularize_inplace(H_L, H_R, r);
+      const Eigen::Matrix3d U = H_L.topRows(3);
+      const double dmax = U.diagonal().cwiseAbs().maxCoeff();
+      if (dmax > 0.0 && U.diagonal().cwiseAbs().minCoeff() >= 1e-10 * dmax) {
+        const int m_up = 2 * m - 3;
+        const Eigen::MatrixXd H_up = H_R.bottomRows(m_up);
+        const Eigen::VectorXd r_up = r.tail(m_up);
+        Eigen::MatrixXd S = H_up * StateHelper::marginal_covariance(state, layout.order()) * H_up.transpose();
+        S.diagonal().array() += 1.0;
+        if (r_up.dot(S.llt().solve(r_up)) < options_.chi2_multiplier * estimator::chi2_95(m_up)) {
+          StateHelper::initialize_invertible(state, var, layout.order(), H_R.topRows(3), U, r.head(3),
+                                             Eigen::Matrix3d::Identity());
+          points_[f->feature_id] = TargetPoint{var, frame_};  // active in the Schmidt update below
+          apply_update(state, layout.order(), H_up, r_up);
+          initialized = true;
+        }
+      }
+    }
+    if (!initialized) {
+      ++stats_.points_rejected_init;
+      continue;
+    }
+    points_[f->feature_id] = TargetPoint{var, frame_};
+    tracks_.remove(f->feature_id);
+    ++stats_.points_initialized;
+    stats_.obs_used += m;
+    ++added;
+  }
+}
+
+void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estimator::Feature>> tracks) {
+  if (tracks.empty()) return;
+  const bool global = options_.representation == TargetRepresentation::kGlobal;
+  const auto& cameras = estimator_.cameras();
+  std::set<int64_t> times;
+  const estimator::ClonePoses poses_in_T = poses_in_target(state, &times);
   const estimator::FeatureTriangulator triangulator(options_.triangulation, cameras);
 
   estimator::ColumnLayout layout;
@@ -336,20 +587,7 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
     row += n;
   }
   estimator::measurement_compress_inplace(H, r);
-  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(r.size(), r.size());
-  bool applied = false;
-  if (options_.mode == TargetUpdateMode::kEkf) {
-    applied = StateHelper::ekf_update(state, layout.order(), H, r, R);
-  } else {
-    std::vector<TypePtr> nuisance;
-    for (const auto& v : state.variables()) {
-      if (v == target_) continue;
-      bool is_clone = false;
-      for (const auto& kv : clones_) is_clone = is_clone || kv.second == v;
-      if (!is_clone) nuisance.push_back(v);
-    }
-    applied = StateHelper::schmidt_update(state, layout.order(), H, r, R, nuisance);
-  }
+  const bool applied = apply_update(state, layout.order(), H, r);
   if (applied) ++stats_.updates;
 }
 

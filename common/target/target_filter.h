@@ -29,6 +29,20 @@
 //   kSkf   StateHelper::schmidt_update with every non-target variable (IMU,
 //          IMU clones, SLAM landmarks) as nuisance: robot estimate and P_RR
 //          are never changed by a target update.
+// Target points in the state (paper Eq. 2), SLAM-like: a target track
+// still seen at the current frame with observations at >= point_init_clone_times
+// target clones (longest first, up to max_target_points) is triangulated in
+// T and added with StateHelper::initialize (χ² test on the rows left after
+// the Givens split; under kSkf the same split with initialize_invertible and
+// a Schmidt update of the remaining rows). Each frame the current
+// observations of the in-state points update [target pose, (IMU pose,
+// global), p_FinT] (per-point χ² gate, then one stacked update in the
+// filter's mode). A point not updated for point_max_lost_frames frames is
+// marginalised; when the cap is reached, points not seen at the current
+// frame are marginalised (longest unseen first) to make room. The persistent
+// points anchor the T origin across windows, which MSCKF-only target updates
+// cannot (docs/target_model.md). Target points are target (active) variables
+// under kSkf. The MSCKF-style update above stays for the other tracks.
 // Initialisation (simulation): from the ground truth at the first frame with
 // target observations (set_ground_truth() before feed_camera), with the
 // prior init_sigmas (uncorrelated with the robot). A front-end initialiser
@@ -39,6 +53,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include "common/estimator/feature_database.h"
@@ -93,6 +108,10 @@ struct TargetFilterOptions {
   TargetInitSigmas init_sigmas;
   double chi2_multiplier{1.0};
   int min_clone_times{2};
+  // Target points in the state (0 disables them: MSCKF-only target updates).
+  int max_target_points{25};
+  int point_init_clone_times{3};
+  int point_max_lost_frames{10};
   estimator::TriangulationOptions triangulation;
 
   TargetNoise noise() const;
@@ -109,9 +128,20 @@ struct TargetUpdateStats {
   int64_t obs_used{0};             // observations in tracks that passed the gate
   // Whitened raw residuals (before the nullspace projection) of used tracks:
   // sum, sum of squares, count (diagnostics: mean should be ≈ 0).
+  int64_t points_initialized{0};
+  int64_t points_rejected_init{0};   // triangulation, rank or χ² at initialisation
+  int64_t point_updates{0};          // point observations sets used in updates
+  int64_t points_rejected_chi2{0};
+  int64_t points_marginalized{0};
   double residual_sum{0.0};
   double residual_sq_sum{0.0};
   int64_t residual_count{0};
+};
+
+/// A target point p_FinT kept in the state.
+struct TargetPoint {
+  std::shared_ptr<estimator::Vec> var;
+  int64_t last_updated_frame{0};
 };
 
 class TargetFilter : public estimator::VioExtension {
@@ -139,6 +169,8 @@ class TargetFilter : public estimator::VioExtension {
   /// the Jacobian w.r.t. [δθ_I δp_I δp_T]).
   Eigen::Vector3d p_TinI(Eigen::Matrix3d* cov = nullptr) const;
   const TargetUpdateStats& stats() const { return stats_; }
+  /// Target points in the state, by feature id.
+  const std::map<int64_t, TargetPoint>& points() const { return points_; }
 
   // estimator::VioExtension
   bool propagate_jointly(const estimator::State& state, const estimator::ImuValue& x0, const estimator::ImuValue& x1,
@@ -154,6 +186,16 @@ class TargetFilter : public estimator::VioExtension {
  private:
   bool initialize_from_truth(estimator::State& state, int64_t utime);
   void update_tracks(estimator::State& state, std::vector<std::shared_ptr<estimator::Feature>> tracks);
+  void update_points(estimator::State& state, const std::vector<FeatureObservation>& obs);
+  void initialize_points(estimator::State& state, int64_t utime);
+  void marginalize_point(estimator::State& state, int64_t feature_id);
+  // IMU pose at each IMU+target clone time in T; `times` gets those times.
+  estimator::ClonePoses poses_in_target(const estimator::State& state, std::set<int64_t>* times) const;
+  // Every variable but the target, its clones and the target points.
+  std::vector<estimator::TypePtr> nuisance_variables(const estimator::State& state) const;
+  // ekf_update (kEkf) or schmidt_update with nuisance_variables (kSkf).
+  bool apply_update(estimator::State& state, const std::vector<estimator::TypePtr>& order, const Eigen::MatrixXd& H,
+                    const Eigen::VectorXd& r);
 
   estimator::VioEstimator& estimator_;
   TargetFilterOptions options_;
@@ -164,6 +206,8 @@ class TargetFilter : public estimator::VioExtension {
   estimator::FeatureDatabase tracks_;
   std::optional<GroundTruth> truth_;
   TargetUpdateStats stats_;
+  std::map<int64_t, TargetPoint> points_;
+  int64_t frame_{0};
 };
 
 }  // namespace target
