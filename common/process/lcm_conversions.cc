@@ -25,6 +25,27 @@ void write(const Eigen::Matrix<double, N, 1>& v, double (&a)[N]) {
   for (int i = 0; i < N; ++i) a[i] = v(i);
 }
 
+template <int N>
+void write_matrix(const Eigen::Matrix<double, N, N>& m, double (&a)[N * N]) {
+  for (int r = 0; r < N; ++r)
+    for (int c = 0; c < N; ++c) a[r * N + c] = m(r, c);
+}
+
+template <int N>
+Eigen::Matrix<double, N, N> read_matrix(const double (&a)[N * N], const char* what, int64_t utime) {
+  Eigen::Matrix<double, N, N> m;
+  for (int r = 0; r < N; ++r) {
+    for (int c = 0; c < N; ++c) {
+      const double v = a[r * N + c];
+      if (!std::isfinite(v)) {
+        throw std::invalid_argument(std::string(what) + " has a non-finite value at utime " + std::to_string(utime));
+      }
+      m(r, c) = v;
+    }
+  }
+  return m;
+}
+
 }  // namespace
 
 imu_t to_lcm(const ImuData& imu) {
@@ -167,6 +188,71 @@ NavState from_lcm(const nav_state_t& msg) {
   s.num_slam_features = msg.num_slam_features;
   s.num_msckf_features = msg.num_msckf_features;
   return s;
+}
+
+target_state_t to_lcm(const TargetStateEstimate& s) {
+  target_state_t msg{};
+  msg.utime = s.utime;
+  msg.representation =
+      s.representation == TargetFrame::kGlobal ? target_state_t::GLOBAL : target_state_t::LOCAL;
+  write<4>(s.q_ItoT, msg.q_ItoT);
+  write<3>(s.p_TinI, msg.p_TinI);
+  write<4>(s.q_GtoT, msg.q_GtoT);
+  write<3>(s.p_TinG, msg.p_TinG);
+  write<3>(s.v_TinT, msg.v_TinT);
+  write<3>(s.w_TinT, msg.w_TinT);
+  write_matrix<12>(s.covariance, msg.covariance);
+  msg.num_target_points = s.num_target_points;
+  return msg;
+}
+
+TargetStateEstimate from_lcm(const target_state_t& msg) {
+  TargetStateEstimate s;
+  s.utime = msg.utime;
+  if (msg.representation == target_state_t::GLOBAL) {
+    s.representation = TargetFrame::kGlobal;
+  } else if (msg.representation == target_state_t::LOCAL) {
+    s.representation = TargetFrame::kLocal;
+  } else {
+    throw std::invalid_argument("target_state_t: unknown representation " + std::to_string(msg.representation));
+  }
+  s.q_ItoT = read<4>(msg.q_ItoT, "target_state_t.q_ItoT", msg.utime);
+  s.p_TinI = read<3>(msg.p_TinI, "target_state_t.p_TinI", msg.utime);
+  s.q_GtoT = read<4>(msg.q_GtoT, "target_state_t.q_GtoT", msg.utime);
+  s.p_TinG = read<3>(msg.p_TinG, "target_state_t.p_TinG", msg.utime);
+  s.v_TinT = read<3>(msg.v_TinT, "target_state_t.v_TinT", msg.utime);
+  s.w_TinT = read<3>(msg.w_TinT, "target_state_t.w_TinT", msg.utime);
+  s.covariance = read_matrix<12>(msg.covariance, "target_state_t.covariance", msg.utime);
+  if (msg.num_target_points < 0) {
+    throw std::invalid_argument("target_state_t: negative num_target_points " +
+                                std::to_string(msg.num_target_points));
+  }
+  s.num_target_points = msg.num_target_points;
+  return s;
+}
+
+target_prediction_t to_lcm(const TargetPosePrediction& p) {
+  target_prediction_t msg{};
+  msg.utime = p.utime;
+  msg.prediction_utime = p.prediction_utime;
+  write<4>(p.q_GtoT, msg.q_GtoT);
+  write<3>(p.p_TinG, msg.p_TinG);
+  write<4>(p.q_ItoT, msg.q_ItoT);
+  write<3>(p.p_TinI, msg.p_TinI);
+  write_matrix<6>(p.covariance, msg.covariance);
+  return msg;
+}
+
+TargetPosePrediction from_lcm(const target_prediction_t& msg) {
+  TargetPosePrediction p;
+  p.utime = msg.utime;
+  p.prediction_utime = msg.prediction_utime;
+  p.q_GtoT = read<4>(msg.q_GtoT, "target_prediction_t.q_GtoT", msg.utime);
+  p.p_TinG = read<3>(msg.p_TinG, "target_prediction_t.p_TinG", msg.utime);
+  p.q_ItoT = read<4>(msg.q_ItoT, "target_prediction_t.q_ItoT", msg.utime);
+  p.p_TinI = read<3>(msg.p_TinI, "target_prediction_t.p_TinI", msg.utime);
+  p.covariance = read_matrix<6>(msg.covariance, "target_prediction_t.covariance", msg.utime);
+  return p;
 }
 
 }  // namespace vimot

@@ -7,10 +7,13 @@
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
 #include "common/types/sensor_data.h"
+#include "common/types/target_state.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
 #include "vimot/imu_t.hpp"
 #include "vimot/nav_state_t.hpp"
+#include "vimot/target_prediction_t.hpp"
+#include "vimot/target_state_t.hpp"
 
 namespace vimot {
 
@@ -25,5 +28,11 @@ GroundTruth from_lcm(const ground_truth_t& msg);
 
 nav_state_t to_lcm(const NavState& state);
 NavState from_lcm(const nav_state_t& msg);
+
+target_state_t to_lcm(const TargetStateEstimate& state);
+TargetStateEstimate from_lcm(const target_state_t& msg);
+
+target_prediction_t to_lcm(const TargetPosePrediction& prediction);
+TargetPosePrediction from_lcm(const target_prediction_t& msg);
 
 }  // namespace vimot

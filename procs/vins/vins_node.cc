@@ -10,6 +10,12 @@ namespace vimot {
 VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, EventCallback on_event)
     : options_(options), estimator_(options.vio), on_state_(std::move(on_state)), on_event_(std::move(on_event)) {}
 
+void VinsNode::set_frame_hooks(std::function<void(const CameraFrame&)> before_frame,
+                               std::function<void()> after_update) {
+  before_frame_ = std::move(before_frame);
+  after_update_ = std::move(after_update);
+}
+
 void VinsNode::say(VinsEvent::Kind kind, const std::string& message) {
   if (on_event_) on_event_(VinsEvent{kind, message});
 }
@@ -70,10 +76,12 @@ void VinsNode::process_ready_frames(int64_t latest_imu_utime) {
 }
 
 void VinsNode::process_frame(const CameraFrame& frame) {
+  if (before_frame_) before_frame_(frame);
   const estimator::FrameStatus status = estimator_.feed_camera(frame);
   switch (status) {
     case estimator::FrameStatus::kProcessed:
       publish_updated();
+      if (after_update_) after_update_();
       return;
     case estimator::FrameStatus::kDiverged: {
       ++resets_;

@@ -55,10 +55,17 @@ class VinsNode {
   /// Processes every queued frame with the IMU data there is.
   void flush();
 
+  /// Lets an extension of the process (the target filter) act around each
+  /// frame: `before_frame` runs before the estimator sees a frame,
+  /// `after_update` after a processed frame's updated state was published.
+  void set_frame_hooks(std::function<void(const CameraFrame&)> before_frame, std::function<void()> after_update);
+
   bool initialized() const { return estimator_.initialized(); }
   int64_t frames_processed() const { return estimator_.frames_processed(); }
   int64_t resets() const { return resets_; }
   const estimator::VioEstimator& estimator() const { return estimator_; }
+  /// For attaching an estimator extension (VioEstimator::set_extension).
+  estimator::VioEstimator& mutable_estimator() { return estimator_; }
 
  private:
   void process_ready_frames(int64_t imu_utime);
@@ -71,9 +78,10 @@ class VinsNode {
   estimator::VioEstimator estimator_;
   StateCallback on_state_;
   EventCallback on_event_;
+  std::function<void(const CameraFrame&)> before_frame_;
+  std::function<void()> after_update_;
   std::deque<CameraFrame> queued_frames_;
   int64_t last_frame_utime_{-1};
-  bool reset_pending_{false};
   int64_t resets_{0};
 };
 

@@ -1,0 +1,86 @@
+// target_filter: the joint robot + moving-target filter (Schmidt-EKF paper)
+// as an LCM process. Subscribes IMU, FEATURES (static + target
+// observations) and GROUND_TRUTH (initialisation in simulation); publishes
+// per processed frame NAV_STATE (nav_state_t, updated = true),
+// TARGET_STATE (target_state_t) and TARGET_PREDICTION (target_prediction_t).
+// All logic is in TargetFilterNode / the target library; this file moves bytes.
+#include <chrono>
+
+#include "common/process/lcm_conversions.h"
+#include "common/process/process.h"
+#include "procs/target_filter/target_filter_node.h"
+#include "vimot/features_t.hpp"
+#include "vimot/ground_truth_t.hpp"
+#include "vimot/imu_t.hpp"
+
+namespace {
+
+int run(int argc, const char* const* argv) {
+  vimot::Process process("target_filter",
+                         "Joint VIO + moving-target filter: IMU + FEATURES in,\n"
+                         "NAV_STATE, TARGET_STATE and TARGET_PREDICTION out.\n"
+                         "Configured by config/target_filter.yaml (target filter options, channels;\n"
+                         "estimator, calibration and initialisation from its vins_config).",
+                         /*config_required=*/true);
+  process.args().add_option("perturb-seed", "N",
+                            "start from ground truth perturbed with this seed (overrides init.perturb_seed)");
+  process.args().add_option("max-wait", "SECONDS",
+                            "process a queued camera frame after this much wall time without IMU", "0.5");
+  if (!process.init(argc, argv)) return 0;
+
+  vimot::TargetFilterNodeOptions options = vimot::node_options_from_config(process.config());
+  if (process.args().given("perturb-seed")) {
+    options.perturb_seed = static_cast<uint64_t>(process.args().get_int("perturb-seed"));
+  }
+  const double max_wait = process.args().get_double("max-wait");
+
+  const std::string nav_channel = process.channel("nav_state", "NAV_STATE");
+  const std::string target_channel = process.channel("target_state", "TARGET_STATE");
+  const std::string prediction_channel = process.channel("target_prediction", "TARGET_PREDICTION");
+  vimot::TargetFilterNode::Callbacks callbacks;
+  callbacks.on_nav_state = [&](const vimot::NavState& s) { process.publish(nav_channel, vimot::to_lcm(s)); };
+  callbacks.on_target_state = [&](const vimot::TargetStateEstimate& s) {
+    process.publish(target_channel, vimot::to_lcm(s));
+  };
+  callbacks.on_target_prediction = [&](const vimot::TargetPosePrediction& p) {
+    process.publish(prediction_channel, vimot::to_lcm(p));
+  };
+  callbacks.on_event = [&](const vimot::TargetFilterEvent& e) {
+    switch (e.kind) {
+      case vimot::TargetFilterEvent::Kind::kInfo: vimot::log_info(e.message); break;
+      case vimot::TargetFilterEvent::Kind::kDropped: process.report_dropped(e.message); break;
+      case vimot::TargetFilterEvent::Kind::kError: process.report_error(e.message); break;
+    }
+  };
+  vimot::TargetFilterNode node(options, callbacks);
+  if (!options.target_enabled) vimot::log_info("target.mode none: VIO only, no target outputs");
+
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point last_imu_wall = Clock::now();
+  process.subscribe<vimot::imu_t>(process.channel("imu", "IMU"), [&](const vimot::imu_t& m) {
+    last_imu_wall = Clock::now();
+    node.on_imu(vimot::from_lcm(m));
+  });
+  process.subscribe<vimot::features_t>(process.channel("features", "FEATURES"),
+                                       [&](const vimot::features_t& m) { node.on_frame(vimot::from_lcm(m)); });
+  // Ground truth also initialises the target (simulation).
+  process.subscribe<vimot::ground_truth_t>(process.channel("ground_truth", "GROUND_TRUTH"),
+                                           [&](const vimot::ground_truth_t& m) {
+                                             node.on_ground_truth(vimot::from_lcm(m));
+                                           });
+  vimot::log_info(options.init_from_ground_truth ? "waiting for GROUND_TRUTH to initialise"
+                                                 : "initialising at rest from the IMU");
+  const int status = process.run([&] {
+    if (std::chrono::duration<double>(Clock::now() - last_imu_wall).count() > max_wait) node.flush();
+  });
+  node.flush();
+  vimot::log_info("processed ", node.frames_processed(), " frames, ", node.resets(), " resets, target ",
+                  node.target_initialized() ? "initialised" : "not initialised");
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return vimot::run_process_main([&] { return run(argc, argv); });
+}
