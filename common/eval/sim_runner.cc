@@ -139,18 +139,14 @@ uint64_t perturb_seed_of(const MonteCarloOptions& o, uint64_t sim_seed) {
   return o.fixed_perturb_seed != 0 ? o.fixed_perturb_seed : perturb_seed_for_run(sim_seed);
 }
 
-std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const estimator::VioOptions& options,
-                                          const MonteCarloOptions& o,
-                                          const std::function<void(const MonteCarloProgress&)>& progress) {
-  if (o.runs < 1) throw std::invalid_argument("run_monte_carlo: runs must be >= 1, got " + std::to_string(o.runs));
-  options.validate();
-  sim::validate(base);
+void run_parallel(int jobs, int threads_wanted, const std::function<void(int, const std::function<void(double)>&)>& job,
+                  const std::function<void(const MonteCarloProgress&)>& progress) {
+  if (jobs < 1) throw std::invalid_argument("run_parallel: jobs must be >= 1, got " + std::to_string(jobs));
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int threads = std::max(1, std::min(o.threads > 0 ? o.threads : hw, o.runs));
+  const int threads = std::max(1, std::min(threads_wanted > 0 ? threads_wanted : hw, jobs));
   const auto start = std::chrono::steady_clock::now();
 
-  std::vector<SimRunResult> results(static_cast<std::size_t>(o.runs));
-  std::vector<std::atomic<double>> fraction(static_cast<std::size_t>(o.runs));
+  std::vector<std::atomic<double>> fraction(static_cast<std::size_t>(jobs));
   for (auto& f : fraction) f = 0.0;
   std::atomic<int> next{0};
   std::atomic<int> done{0};
@@ -160,16 +156,10 @@ std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const esti
   std::condition_variable cv;
 
   auto worker = [&] {
-    for (int i = next++; i < o.runs && !failed; i = next++) {
-      const uint64_t seed = o.first_seed + static_cast<uint64_t>(i);
+    for (int i = next++; i < jobs && !failed; i = next++) {
       try {
-        sim::SimConfig cfg = base;
-        cfg.seed = seed;
-        SimRunOptions ro;
-        ro.keep_samples = o.keep_samples;
         std::atomic<double>& fr = fraction[static_cast<std::size_t>(i)];
-        ro.progress = [&fr](double f) { fr = f; };
-        results[static_cast<std::size_t>(i)] = run_vio_on_sim(cfg, options, perturb_seed_of(o, seed), ro);
+        job(i, [&fr](double f) { fr = f; });
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
         if (!first_error) first_error = std::current_exception();
@@ -187,10 +177,10 @@ std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const esti
     if (!progress) return;
     MonteCarloProgress p;
     p.runs_done = done;
-    p.runs_total = o.runs;
+    p.runs_total = jobs;
     double sum = 0.0;
     for (const auto& f : fraction) sum += f;
-    p.fraction = std::min(1.0, sum / o.runs);
+    p.fraction = std::min(1.0, sum / jobs);
     p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     progress(p);
   };
@@ -199,7 +189,7 @@ std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const esti
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   {
     std::unique_lock<std::mutex> lock(mutex);
-    while (done < o.runs && !failed) {
+    while (done < jobs && !failed) {
       cv.wait_for(lock, std::chrono::milliseconds(250));
       lock.unlock();
       report();
@@ -209,6 +199,27 @@ std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const esti
   for (auto& t : pool) t.join();
   if (first_error) std::rethrow_exception(first_error);
   report();
+}
+
+std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const estimator::VioOptions& options,
+                                          const MonteCarloOptions& o,
+                                          const std::function<void(const MonteCarloProgress&)>& progress) {
+  if (o.runs < 1) throw std::invalid_argument("run_monte_carlo: runs must be >= 1, got " + std::to_string(o.runs));
+  options.validate();
+  sim::validate(base);
+  std::vector<SimRunResult> results(static_cast<std::size_t>(o.runs));
+  run_parallel(
+      o.runs, o.threads,
+      [&](int i, const std::function<void(double)>& fr) {
+        const uint64_t seed = o.first_seed + static_cast<uint64_t>(i);
+        sim::SimConfig cfg = base;
+        cfg.seed = seed;
+        SimRunOptions ro;
+        ro.keep_samples = o.keep_samples;
+        ro.progress = fr;
+        results[static_cast<std::size_t>(i)] = run_vio_on_sim(cfg, options, perturb_seed_of(o, seed), ro);
+      },
+      progress);
   return results;
 }
 

@@ -104,6 +104,16 @@ struct MonteCarloProgress {
   double elapsed_s{0.0};
 };
 
+/// Runs job(i, progress_i) for i in [0, jobs) on `threads` std::threads
+/// (0: hardware concurrency; at most `jobs`), each job on one thread;
+/// progress_i(f) reports job i's fraction done (thread-safe). `progress` is
+/// called on the calling thread about every 0.25 s and once at the end
+/// (runs_* count jobs). The first exception of a job is rethrown after all
+/// threads are joined. The building block of every Monte Carlo here: jobs
+/// write their own result slot, so results do not depend on `threads`.
+void run_parallel(int jobs, int threads, const std::function<void(int, const std::function<void(double)>&)>& job,
+                  const std::function<void(const MonteCarloProgress&)>& progress = {});
+
 /// Perturbation seed of run with simulator seed `sim_seed` under `o`.
 uint64_t perturb_seed_of(const MonteCarloOptions& o, uint64_t sim_seed);
 

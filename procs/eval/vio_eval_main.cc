@@ -3,8 +3,6 @@
 // as the `vins` process. Runs are independent std::threads; run i uses
 // simulator seed first_seed + i. Prints a per-run table and the average;
 // --out writes TUM trajectories, per-frame error CSVs and summaries.
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +12,7 @@
 
 #include "common/config/config.h"
 #include "common/eval/machine.h"
+#include "common/eval/progress.h"
 #include "common/eval/report.h"
 #include "common/eval/sim_runner.h"
 #include "common/eval/vins_config.h"
@@ -26,51 +25,8 @@ namespace {
 
 using namespace vimot;
 
-std::string hms(double s) {
-  const long t = static_cast<long>(s + 0.5);
-  char buf[32];
-  if (t >= 3600) {
-    std::snprintf(buf, sizeof(buf), "%ldh%02ldm%02lds", t / 3600, (t / 60) % 60, t % 60);
-  } else {
-    std::snprintf(buf, sizeof(buf), "%ldm%02lds", t / 60, t % 60);
-  }
-  return buf;
-}
-
-// Progress on stderr: a redrawn bar on a terminal, a line per finished run
-// otherwise (logs stay readable).
-class ProgressBar {
- public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
-
-  void update(const eval::MonteCarloProgress& p) {
-    if (!enabled_) return;
-    const double eta = p.fraction > 1e-6 ? p.elapsed_s * (1.0 - p.fraction) / p.fraction : 0.0;
-    char line[160];
-    if (tty_) {
-      const int width = 30;
-      const int filled = static_cast<int>(p.fraction * width + 0.5);
-      std::string bar(static_cast<std::size_t>(filled), '#');
-      bar.resize(width, '.');
-      std::snprintf(line, sizeof(line), "\r[%s] %3.0f%%  runs %d/%d  elapsed %s  ETA %s   ", bar.c_str(),
-                    100.0 * p.fraction, p.runs_done, p.runs_total, hms(p.elapsed_s).c_str(),
-                    p.fraction > 1e-6 ? hms(eta).c_str() : "--");
-      std::fputs(line, stderr);
-      if (p.runs_done == p.runs_total) std::fputs("\n", stderr);
-    } else if (p.runs_done != last_done_) {
-      std::snprintf(line, sizeof(line), "runs %d/%d  elapsed %s  ETA %s\n", p.runs_done, p.runs_total,
-                    hms(p.elapsed_s).c_str(), hms(eta).c_str());
-      std::fputs(line, stderr);
-    }
-    last_done_ = p.runs_done;
-    std::fflush(stderr);
-  }
-
- private:
-  bool enabled_;
-  bool tty_;
-  int last_done_{0};
-};
+using eval::hms;
+using eval::ProgressBar;
 
 std::string seed_name(uint64_t seed) {
   char buf[32];

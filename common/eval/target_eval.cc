@@ -1,0 +1,479 @@
+#include "common/eval/target_eval.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <variant>
+
+#include "common/estimator/state_helper.h"
+#include "common/eval/initial_estimate.h"
+#include "common/eval/json.h"
+#include "common/eval/nav_state_of.h"
+#include "common/eval/writers.h"
+#include "common/math/quat.h"
+#include "common/sim/simulator.h"
+#include "common/target/target_conversion.h"
+
+namespace vimot {
+namespace eval {
+
+using estimator::FrameStatus;
+using estimator::StateHelper;
+using estimator::VioEstimator;
+using target::TargetFilterOptions;
+using target::TargetRepresentation;
+using target::TargetUpdateMode;
+
+target::TargetUpdateMode parse_target_mode(const std::string& s) {
+  if (s == "ekf") return TargetUpdateMode::kEkf;
+  if (s == "skf") return TargetUpdateMode::kSkf;
+  if (s == "off") return TargetUpdateMode::kOff;
+  throw std::invalid_argument("target mode must be ekf|skf|off, got '" + s + "'");
+}
+
+target::TargetRepresentation parse_target_representation(const std::string& s) {
+  if (s == "global") return TargetRepresentation::kGlobal;
+  if (s == "local") return TargetRepresentation::kLocal;
+  throw std::invalid_argument("target representation must be global|local, got '" + s + "'");
+}
+
+namespace {
+
+void check_keys(const Config& c, const std::set<std::string>& allowed) {
+  for (const std::string& k : c.keys()) {
+    if (!allowed.count(k)) c.fail(k, "is not a known key");
+  }
+}
+
+double positive(const Config& c, const std::string& key, double fallback) {
+  const double v = c.get_or<double>(key, fallback);
+  if (!(v > 0.0)) c.fail(key, "must be > 0, got " + std::to_string(v));
+  return v;
+}
+
+int at_least(const Config& c, const std::string& key, int fallback, int min) {
+  const int v = c.get_or<int>(key, fallback);
+  if (v < min) c.fail(key, "must be >= " + std::to_string(min) + ", got " + std::to_string(v));
+  return v;
+}
+
+}  // namespace
+
+target::TargetFilterOptions target_filter_options(const Config& config) {
+  TargetFilterOptions o;
+  if (!config.has("target")) return o;
+  const Config c = config.sub("target");
+  check_keys(c, {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times", "init_sigmas",
+                 "points", "prediction_horizon_s" /* the vimot-target-filter process's, ignored here */});
+  if (c.has("mode")) {
+    try {
+      o.mode = parse_target_mode(c.get<std::string>("mode"));
+    } catch (const std::invalid_argument& e) {
+      c.fail("mode", e.what());
+    }
+  }
+  if (c.has("representation")) {
+    try {
+      o.representation = parse_target_representation(c.get<std::string>("representation"));
+    } catch (const std::invalid_argument& e) {
+      c.fail("representation", e.what());
+    }
+  }
+  o.sigma_t = positive(c, "sigma_t", o.sigma_t);
+  o.planar = c.get_or<bool>("planar", o.planar);
+  o.chi2_multiplier = positive(c, "chi2_multiplier", o.chi2_multiplier);
+  o.min_clone_times = at_least(c, "min_clone_times", o.min_clone_times, 2);
+  if (c.has("init_sigmas")) {
+    const Config s = c.sub("init_sigmas");
+    check_keys(s, {"theta", "p", "v", "w"});
+    o.init_sigmas.theta = positive(s, "theta", o.init_sigmas.theta);
+    o.init_sigmas.p = positive(s, "p", o.init_sigmas.p);
+    o.init_sigmas.v = positive(s, "v", o.init_sigmas.v);
+    o.init_sigmas.w = positive(s, "w", o.init_sigmas.w);
+  }
+  if (c.has("points")) {
+    const Config p = c.sub("points");
+    check_keys(p, {"max", "init_clone_times", "max_lost_frames"});
+    o.max_target_points = at_least(p, "max", o.max_target_points, 0);
+    o.point_init_clone_times = at_least(p, "init_clone_times", o.point_init_clone_times, 2);
+    o.point_max_lost_frames = at_least(p, "max_lost_frames", o.point_max_lost_frames, 1);
+  }
+  return o;
+}
+
+target::TargetFilterOptions load_target_filter_options(const std::string& path) {
+  return target_filter_options(Config::load_file(path));
+}
+
+TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
+                                  const std::optional<target::TargetFilterOptions>& filter_options,
+                                  uint64_t perturb_seed, const std::function<void(double)>& progress) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  sim::SimConfig cfg = sim_config;
+  cfg.ground_truth_events = true;
+  sim::Simulator sim(cfg);
+  VioEstimator est(options);
+  TargetRunResult r;
+  r.sim_seed = cfg.seed;
+  r.perturb_seed = perturb_seed;
+  const int64_t frames_total = std::max<int64_t>(1, sim.camera_frame_count());
+
+  const InitialEstimate x0 = initial_estimate(sim.initial_state(), options, perturb_seed);
+  est.initialize(x0.value, sim.initial_state().utime, x0.P0);
+  std::unique_ptr<target::TargetFilter> filter;
+  if (filter_options) filter = std::make_unique<target::TargetFilter>(est, *filter_options);
+
+  TrajectoryErrors e_ti, e_tg, e_imu;
+  GroundTruth truth;
+  bool have_truth = false;
+  bool target_seen = false;
+  int64_t frames_seen = 0;
+  while (std::optional<sim::SimEvent> ev = sim.next()) {
+    if (const auto* imu = std::get_if<ImuData>(&*ev)) {
+      est.feed_imu(*imu);
+      continue;
+    }
+    if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
+      truth = *gt;
+      have_truth = true;
+      if (filter) filter->set_ground_truth(*gt);
+      continue;
+    }
+    const auto& frame = std::get<CameraFrame>(*ev);
+    ++frames_seen;
+    for (const FeatureObservation& o : frame.observations) target_seen = target_seen || o.is_target;
+    const FrameStatus st = est.feed_camera(frame);
+    if (progress) progress(static_cast<double>(frames_seen) / static_cast<double>(frames_total));
+    if (st == FrameStatus::kDiverged) {
+      r.diverged = true;
+      r.divergence_reason = est.last_divergence().reason;
+      break;
+    }
+    if (st != FrameStatus::kProcessed) continue;
+    if (!have_truth || truth.utime != frame.utime || !target_seen) continue;
+    try {
+      e_imu.add(error_of(nav_state_of(est, true), truth));
+      if (filter && filter->initialized() && truth.has_target) {
+        r.target_initialized = true;
+        const estimator::State& s = est.state();
+        const target::PoseValue ip = target::imu_pose(est.imu_value());
+        const target::TargetValue x = filter->value();
+        const Eigen::Matrix<double, 18, 18> P18 =
+            StateHelper::marginal_covariance(s, {s.imu()->pose()->q(), s.imu()->pose()->p(), filter->target()});
+        target::TargetValue x_i, x_g;
+        target::Matrix12d P_i, P_g;
+        if (filter->options().representation == TargetRepresentation::kLocal) {
+          x_i = x;
+          P_i = P18.block<12, 12>(6, 6);
+          x_g = target::local_to_global(ip, x);
+          P_g = target::local_to_global_covariance(ip, x, P18);
+        } else {
+          x_g = x;
+          P_g = P18.block<12, 12>(6, 6);
+          x_i = target::global_to_local(ip, x);
+          P_i = target::global_to_local_covariance(ip, x, P18);
+        }
+        const Eigen::Matrix3d R_GtoI = quat_to_rot(truth.q_GtoI);
+        const Eigen::Matrix3d R_GtoT = quat_to_rot(truth.q_GtoT);
+        const Eigen::Vector4d q_ItoT_true = rot_to_quat(R_GtoT * R_GtoI.transpose());
+        const Eigen::Vector3d p_TinI_true = R_GtoI * (truth.p_TinG - truth.p_IinG);
+        e_ti.add(compute_error(frame.utime, q_ItoT_true, p_TinI_true, x_i.q_RtoT, x_i.p_TinR, P_i.block<3, 3>(0, 0),
+                               P_i.block<3, 3>(3, 3)));
+        e_tg.add(compute_error(frame.utime, truth.q_GtoT, truth.p_TinG, x_g.q_RtoT, x_g.p_TinR,
+                               P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3)));
+      }
+    } catch (const std::invalid_argument& e) {
+      r.diverged = true;
+      r.divergence_reason = "covariance not positive definite at utime " + std::to_string(frame.utime) + ": " + e.what();
+      break;
+    }
+  }
+  if (progress) progress(1.0);
+  r.target_in_imu = e_ti.summary();
+  r.target_in_world = e_tg.summary();
+  r.imu = e_imu.summary();
+  r.frames_processed = est.frames_processed();
+  if (filter && !r.diverged && filter_options->mode != TargetUpdateMode::kOff && !r.target_initialized) {
+    r.diverged = true;
+    r.divergence_reason = "target never initialised";
+  }
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return r;
+}
+
+TargetCellSummary summarize(const TargetCell& cell) {
+  TargetCellSummary s;
+  std::vector<ErrorSummary> ti, tg, imu;
+  for (const TargetRunResult& r : cell.runs) {
+    ++s.runs;
+    if (r.diverged) {
+      ++s.diverged;
+      continue;
+    }
+    ti.push_back(r.target_in_imu);
+    tg.push_back(r.target_in_world);
+    imu.push_back(r.imu);
+  }
+  s.target_in_imu = aggregate(ti);
+  s.target_in_world = aggregate(tg);
+  s.imu = aggregate(imu);
+  return s;
+}
+
+std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estimator::VioOptions& options,
+                                         const target::TargetFilterOptions& base_filter, const TargetSweepOptions& o,
+                                         const std::function<void(const MonteCarloProgress&)>& progress) {
+  if (o.runs < 1) throw std::invalid_argument("run_target_sweep: runs must be >= 1, got " + std::to_string(o.runs));
+  options.validate();
+  sim::validate(base);
+  std::vector<TargetCell> cells;
+  if (o.vio_only) {
+    TargetCell c;
+    c.vio_only = true;
+    cells.push_back(c);
+  }
+  for (TargetUpdateMode m : o.modes) {
+    for (TargetRepresentation rep : o.representations) {
+      for (double sigma : o.sigmas) {
+        TargetCell c;
+        c.filter = base_filter;
+        c.filter.mode = m;
+        c.filter.representation = rep;
+        c.filter.sigma_t = sigma;
+        cells.push_back(c);
+      }
+    }
+  }
+  if (cells.empty()) throw std::invalid_argument("run_target_sweep: nothing to run");
+  for (TargetCell& c : cells) c.runs.resize(static_cast<std::size_t>(o.runs));
+  const int jobs = static_cast<int>(cells.size()) * o.runs;
+  run_parallel(
+      jobs, o.threads,
+      [&](int j, const std::function<void(double)>& fr) {
+        TargetCell& c = cells[static_cast<std::size_t>(j / o.runs)];
+        const int i = j % o.runs;
+        const uint64_t seed = o.first_seed + static_cast<uint64_t>(i);
+        sim::SimConfig cfg = base;
+        cfg.seed = seed;
+        std::optional<TargetFilterOptions> f;
+        if (!c.vio_only) f = c.filter;
+        c.runs[static_cast<std::size_t>(i)] = run_target_on_sim(cfg, options, f, perturb_seed_for_run(seed), fr);
+      },
+      progress);
+  return cells;
+}
+
+namespace {
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, v);
+  return buf;
+}
+
+// "m / deg" of a MonteCarloSummary, 5 significant-ish digits like the paper.
+std::string md(const MonteCarloSummary& s) {
+  if (s.runs == 0) return "×";
+  const double p = s.rmse_position_m.mean;
+  return fmt(p < 0.1 ? "%.5f" : "%.3f", p) + " / " + fmt("%.3f", s.rmse_orientation_deg.mean);
+}
+
+std::string nees(const MonteCarloSummary& s) {
+  if (s.runs == 0) return "×";
+  return fmt("%.2f", s.nees_position.mean) + " / " + fmt("%.2f", s.nees_orientation.mean);
+}
+
+std::string div_note(const TargetCellSummary& s) {
+  if (s.diverged == 0 || s.diverged == s.runs) return "";
+  return " (" + std::to_string(s.diverged) + " div)";
+}
+
+const TargetCell* find_cell(const std::vector<TargetCell>& cells, TargetUpdateMode m, TargetRepresentation rep,
+                            double sigma) {
+  for (const TargetCell& c : cells) {
+    if (!c.vio_only && c.filter.mode == m && c.filter.representation == rep && c.filter.sigma_t == sigma) return &c;
+  }
+  return nullptr;
+}
+
+std::vector<double> sigmas_of(const std::vector<TargetCell>& cells) {
+  std::vector<double> s;
+  for (const TargetCell& c : cells) {
+    if (!c.vio_only && std::find(s.begin(), s.end(), c.filter.sigma_t) == s.end()) s.push_back(c.filter.sigma_t);
+  }
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
+std::string sigma_str(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", s);
+  return buf;
+}
+
+}  // namespace
+
+std::string target_tables(const std::vector<TargetCell>& cells) {
+  std::ostringstream out;
+  const std::vector<double> sigmas = sigmas_of(cells);
+  const TargetRepresentation reps[] = {TargetRepresentation::kGlobal, TargetRepresentation::kLocal};
+  const struct {
+    TargetUpdateMode mode;
+    const char* title;
+  } tables[] = {{TargetUpdateMode::kEkf, "Table I (EKF, tightly coupled)"}, {TargetUpdateMode::kSkf, "Table II (SKF)"}};
+  for (const auto& t : tables) {
+    bool any = false;
+    for (double s : sigmas)
+      for (auto rep : reps) any = any || find_cell(cells, t.mode, rep, s);
+    if (!any) continue;
+    out << t.title << ": average RMSE m / deg\n\n";
+    out << "| σ_t | T in I (G) | T in G (G) | I in G (G) | T in I (L) | T in G (L) | I in G (L) |\n";
+    out << "| --- | --- | --- | --- | --- | --- | --- |\n";
+    for (double s : sigmas) {
+      out << "| " << sigma_str(s);
+      for (auto rep : reps) {
+        const TargetCell* c = find_cell(cells, t.mode, rep, s);
+        if (!c) {
+          out << " | – | – | –";
+          continue;
+        }
+        const TargetCellSummary cs = summarize(*c);
+        out << " | " << md(cs.target_in_imu) << div_note(cs) << " | " << md(cs.target_in_world) << " | "
+            << md(cs.imu);
+      }
+      out << " |\n";
+    }
+    out << "\n";
+  }
+  for (const TargetCell& c : cells) {
+    if (!c.vio_only) continue;
+    const TargetCellSummary cs = summarize(c);
+    out << "VIO only (no target in the state): IMU in G " << md(cs.imu) << div_note(cs) << ", NEES pos / ori "
+        << nees(cs.imu) << " (" << cs.runs << " runs)\n\n";
+  }
+  out << "Average NEES position / orientation (ideal 3)\n\n";
+  out << "| σ_t | mode | T in I (G) | T in G (G) | I in G (G) | T in I (L) | T in G (L) | I in G (L) |\n";
+  out << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& t : tables) {
+    for (double s : sigmas) {
+      bool any = false;
+      for (auto rep : reps) any = any || find_cell(cells, t.mode, rep, s);
+      if (!any) continue;
+      out << "| " << sigma_str(s) << " | " << target::to_string(t.mode);
+      for (auto rep : reps) {
+        const TargetCell* c = find_cell(cells, t.mode, rep, s);
+        if (!c) {
+          out << " | – | – | –";
+          continue;
+        }
+        const TargetCellSummary cs = summarize(*c);
+        out << " | " << nees(cs.target_in_imu) << " | " << nees(cs.target_in_world) << " | " << nees(cs.imu);
+      }
+      out << " |\n";
+    }
+  }
+  return out.str();
+}
+
+namespace {
+
+void write_mc(JsonWriter& j, const std::string& key, const MonteCarloSummary& s) {
+  j.key(key).begin_object();
+  j.field("rmse_position_m", s.rmse_position_m.mean).field("rmse_position_m_std", s.rmse_position_m.std);
+  j.field("rmse_orientation_deg", s.rmse_orientation_deg.mean)
+      .field("rmse_orientation_deg_std", s.rmse_orientation_deg.std);
+  j.field("nees_position", s.nees_position.mean).field("nees_orientation", s.nees_orientation.mean);
+  j.field("runs", s.runs).field("samples", s.samples);
+  j.end_object();
+}
+
+std::string cell_mode(const TargetCell& c) { return c.vio_only ? "vio" : target::to_string(c.filter.mode); }
+std::string cell_rep(const TargetCell& c) { return c.vio_only ? "-" : target::to_string(c.filter.representation); }
+
+}  // namespace
+
+std::string target_summary_json(const std::vector<TargetCell>& cells, const std::string& sim_config,
+                                const std::string& vins_config, const std::string& target_config,
+                                const TargetSweepOptions& o, double wall_s) {
+  JsonWriter j;
+  j.begin_object();
+  j.field("tool", "vimot-target-eval").field("sim_config", sim_config).field("vins_config", vins_config);
+  j.field("target_config", target_config).field("runs", o.runs).field("first_seed", o.first_seed);
+  j.field("threads", o.threads).field("wall_s", wall_s);
+  j.key("cells").begin_array();
+  for (const TargetCell& c : cells) {
+    const TargetCellSummary s = summarize(c);
+    j.begin_object();
+    j.field("mode", cell_mode(c)).field("representation", cell_rep(c));
+    if (c.vio_only) {
+      j.key("sigma_t").null();
+    } else {
+      j.field("sigma_t", c.filter.sigma_t);
+    }
+    j.field("runs", s.runs).field("diverged", s.diverged);
+    write_mc(j, "target_in_imu", s.target_in_imu);
+    write_mc(j, "target_in_world", s.target_in_world);
+    write_mc(j, "imu", s.imu);
+    j.key("per_run").begin_array();
+    for (const TargetRunResult& r : c.runs) {
+      j.begin_object();
+      j.field("sim_seed", r.sim_seed).field("perturb_seed", r.perturb_seed).field("diverged", r.diverged);
+      if (r.diverged) j.field("divergence_reason", r.divergence_reason);
+      j.key("target_in_imu");
+      write_summary_json(j, r.target_in_imu);
+      j.key("target_in_world");
+      write_summary_json(j, r.target_in_world);
+      j.key("imu");
+      write_summary_json(j, r.imu);
+      j.field("wall_s", r.wall_s);
+      j.end_object();
+    }
+    j.end_array();
+    j.end_object();
+  }
+  j.end_array();
+  j.end_object();
+  return j.str();
+}
+
+std::string target_summary_csv(const std::vector<TargetCell>& cells) {
+  std::ostringstream out;
+  out << "mode,representation,sigma_t,run,diverged,"
+         "ti_rmse_p_m,ti_rmse_r_deg,ti_nees_p,ti_nees_r,"
+         "tg_rmse_p_m,tg_rmse_r_deg,tg_nees_p,tg_nees_r,"
+         "imu_rmse_p_m,imu_rmse_r_deg,imu_nees_p,imu_nees_r\n";
+  auto row = [&out](const ErrorSummary& a, const ErrorSummary& b, const ErrorSummary& c) {
+    for (const ErrorSummary* s : {&a, &b, &c}) {
+      out << ',' << fmt("%.9g", s->rmse_position_m) << ',' << fmt("%.9g", s->rmse_orientation_deg) << ','
+          << fmt("%.9g", s->nees_position) << ',' << fmt("%.9g", s->nees_orientation);
+    }
+    out << '\n';
+  };
+  auto mean_of = [](const MonteCarloSummary& m) {
+    ErrorSummary s;
+    s.rmse_position_m = m.rmse_position_m.mean;
+    s.rmse_orientation_deg = m.rmse_orientation_deg.mean;
+    s.nees_position = m.nees_position.mean;
+    s.nees_orientation = m.nees_orientation.mean;
+    return s;
+  };
+  for (const TargetCell& c : cells) {
+    const std::string head = cell_mode(c) + "," + cell_rep(c) + "," + (c.vio_only ? "" : sigma_str(c.filter.sigma_t));
+    for (const TargetRunResult& r : c.runs) {
+      out << head << ',' << r.sim_seed << ',' << (r.diverged ? 1 : 0);
+      row(r.target_in_imu, r.target_in_world, r.imu);
+    }
+    const TargetCellSummary s = summarize(c);
+    out << head << ",mean," << s.diverged;
+    row(mean_of(s.target_in_imu), mean_of(s.target_in_world), mean_of(s.imu));
+  }
+  return out.str();
+}
+
+}  // namespace eval
+}  // namespace vimot

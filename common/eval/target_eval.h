@@ -1,0 +1,123 @@
+#pragma once
+// The joint robot + target filter (common/target/target_filter.h) on the
+// simulator, evaluated against its truth: one run, the σ_t sweep of
+// Eckenhoff et al., "Schmidt-EKF-based Visual-Inertial Moving Object
+// Tracking", Sec. IV (Tables I and II), and its tables and summary files
+// (vimot-target-eval). No LCM here.
+//
+// One run is run_vio_on_sim's run (same simulator, same perturbed IMU start
+// initial_estimate(..., perturb_seed)) with a TargetFilter attached (none
+// for the VIO-only row); before every camera frame the filter gets the
+// GroundTruth of that utime (set_ground_truth), so the target is
+// initialised from the truth at the first frame with target observations,
+// as in tests/target/target_filter_test.cc. Samples: every processed frame
+// with truth at or after the first frame with target observations (the
+// same frames with and without the filter); the target errors only once the
+// filter is initialised. Per sample (error conventions of metrics.h, the
+// target's left error R = Exp(−δθ) R̂ for the orientations):
+//  * target in IMU [q_ItoT, p_TinI]: local directly, global through
+//    global_to_local (covariance by global_to_local_covariance);
+//  * target in world [q_GtoT, p_TinG]: global directly, local through
+//    local_to_global (local_to_global_covariance);
+//  * IMU in world: error_of(nav_state_of(estimator, true), truth), as
+//    vimot-vio-eval.
+// RMSE and mean NEES per run (TrajectoryErrors); a cell of the sweep
+// averages its runs (diverged runs are left out and counted).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/config/config.h"
+#include "common/eval/metrics.h"
+#include "common/eval/sim_runner.h"
+#include "common/target/target_filter.h"
+
+namespace vimot {
+namespace eval {
+
+/// TargetFilterOptions from the `target:` section of `config` (keys mode:
+/// ekf|skf|off, representation: global|local, sigma_t, planar,
+/// chi2_multiplier, min_clone_times, init_sigmas.{theta,p,v,w},
+/// points.{max, init_clone_times, max_lost_frames}; prediction_horizon_s, the
+/// process's, is accepted and ignored); every key optional
+/// (TargetFilterOptions' default). Throws ConfigError naming the key.
+target::TargetFilterOptions target_filter_options(const Config& config);
+target::TargetFilterOptions load_target_filter_options(const std::string& path);
+
+target::TargetUpdateMode parse_target_mode(const std::string& s);                  // ekf|skf|off
+target::TargetRepresentation parse_target_representation(const std::string& s);  // global|local
+
+struct TargetRunResult {
+  uint64_t sim_seed{0};
+  uint64_t perturb_seed{0};
+  ErrorSummary target_in_imu;    // [q_ItoT, p_TinI]
+  ErrorSummary target_in_world;  // [q_GtoT, p_TinG]
+  ErrorSummary imu;              // [q_GtoI, p_IinG]
+  bool target_initialized{false};
+  int64_t frames_processed{0};
+  bool diverged{false};
+  std::string divergence_reason;
+  double wall_s{0.0};
+};
+
+/// One run on `sim_config` (its seed and duration); filter == nullopt: VIO
+/// only. `progress` gets the fraction of camera frames done.
+TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
+                                  const std::optional<target::TargetFilterOptions>& filter, uint64_t perturb_seed,
+                                  const std::function<void(double)>& progress = {});
+
+/// One cell of the sweep: a filter configuration (or VIO only) × runs.
+struct TargetCell {
+  bool vio_only{false};
+  target::TargetFilterOptions filter;  // mode, representation, sigma_t set per cell
+  std::vector<TargetRunResult> runs;
+};
+
+/// Mean over the non-diverged runs of a cell.
+struct TargetCellSummary {
+  int runs{0};
+  int diverged{0};
+  MonteCarloSummary target_in_imu;
+  MonteCarloSummary target_in_world;
+  MonteCarloSummary imu;
+};
+TargetCellSummary summarize(const TargetCell& cell);
+
+struct TargetSweepOptions {
+  std::vector<double> sigmas{0.001, 0.005, 0.01, 0.05, 0.1, 0.5};
+  std::vector<target::TargetUpdateMode> modes{target::TargetUpdateMode::kEkf, target::TargetUpdateMode::kSkf};
+  std::vector<target::TargetRepresentation> representations{target::TargetRepresentation::kGlobal,
+                                                            target::TargetRepresentation::kLocal};
+  bool vio_only{true};  // add the VIO-only cell (first)
+  int runs{30};
+  uint64_t first_seed{1};
+  int threads{0};
+};
+
+/// Every cell (VIO only first, then modes × representations × sigmas in
+/// that nesting) × runs on o.threads threads (run_parallel); run i of every
+/// cell uses simulator seed first_seed + i and perturbation seed
+/// perturb_seed_for_run(first_seed + i). Deterministic whatever the thread
+/// count. `base_filter` gives the options not swept.
+std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estimator::VioOptions& options,
+                                         const target::TargetFilterOptions& base_filter, const TargetSweepOptions& o,
+                                         const std::function<void(const MonteCarloProgress&)>& progress = {});
+
+/// Markdown tables in the layout of the paper's Tables I (EKF) and II (SKF):
+/// rows σ_t, column groups global | local, each "target in IMU, target in
+/// world, IMU in world" as "m / deg"; then the VIO-only row and a NEES
+/// table. "×" marks a cell whose runs all diverged, "(k div)" some.
+std::string target_tables(const std::vector<TargetCell>& cells);
+
+/// summary.json: context and one object per cell (means, std, per run).
+std::string target_summary_json(const std::vector<TargetCell>& cells, const std::string& sim_config,
+                                const std::string& vins_config, const std::string& target_config,
+                                const TargetSweepOptions& o, double wall_s);
+
+/// summary.csv: one row per cell and run, then per cell a row run = "mean".
+std::string target_summary_csv(const std::vector<TargetCell>& cells);
+
+}  // namespace eval
+}  // namespace vimot
