@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's main job: the simulated scenario through the LCM stack.
 # Installs what is missing, builds, starts the processes of
-# sheriff_configs/sim_demo.pmd with vimot-sheriff (simulator, vins,
-# lcm-logger), and prints a summary: processes, messages per channel, the
+# sheriff_configs/sim_demo.pmd with vimot-sheriff (simulator, vins, the
+# target filter, lcm-logger), and prints a summary: processes, messages per channel, the
 # VIO accuracy of the LCM run against ground truth, the same scenario run
 # offline (in-process, same libraries) for comparison, and the log path.
 #
@@ -61,5 +61,8 @@ perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VI
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --json "$out/lcm_summary.json" \
   --compare "$out/offline/summary.json" | sed 's/^/   /'
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
+echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal VINS_STATE):"
+"$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE \
+  --compare "$out/lcm_summary.json" | sed 's/^/   /'
 echo "== log: $VIMOT_LOG"
 echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
