@@ -1,5 +1,7 @@
 #include "common/eval/vins_config.h"
 
+#include <stdexcept>
+
 #include <sstream>
 
 #include "common/config/config.h"
@@ -100,6 +102,21 @@ estimator::VioOptions options_matching_sim(estimator::VioOptions o, const sim::S
   o.propagator.gravity_magnitude = s.imu.gravity;
   o.static_init.gravity_magnitude = s.imu.gravity;
   return o;
+}
+
+EvaluationSetup load_evaluation_setup(const std::string& sim_yaml, const std::string& vins_yaml,
+                                      std::optional<double> duration_s) {
+  EvaluationSetup setup;
+  setup.sim = sim::from_config(Config::load_file(sim_yaml));
+  if (duration_s) {
+    if (!(*duration_s > 0.0)) {
+      throw std::invalid_argument("duration must be > 0 s, got " + std::to_string(*duration_s));
+    }
+    setup.sim.duration = *duration_s;
+  }
+  setup.vio = load_vio_options(vins_yaml);
+  setup.model_mismatches = model_mismatches(setup.vio, setup.sim);
+  return setup;
 }
 
 }  // namespace eval

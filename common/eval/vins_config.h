@@ -11,6 +11,7 @@
 // No LCM here.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,19 @@ std::vector<std::string> model_mismatches(const estimator::VioOptions& options, 
 /// VioOptions copied from the simulator (the way tests/estimator started):
 /// `base` with the simulator's cameras, pixel noise, IMU noise and gravity.
 estimator::VioOptions options_matching_sim(estimator::VioOptions base, const sim::SimConfig& sim);
+
+/// What an offline evaluator runs: the scenario of `sim_yaml` (its duration
+/// replaced by `duration_s` if given; it must then be > 0, else
+/// std::invalid_argument) and the estimator of `vins_yaml`, with every
+/// difference between the estimator's model and the simulator (the tools
+/// warn about them).
+struct EvaluationSetup {
+  sim::SimConfig sim;
+  estimator::VioOptions vio;
+  std::vector<std::string> model_mismatches;
+};
+EvaluationSetup load_evaluation_setup(const std::string& sim_yaml, const std::string& vins_yaml,
+                                      std::optional<double> duration_s);
 
 }  // namespace eval
 }  // namespace vimot

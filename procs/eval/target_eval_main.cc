@@ -4,6 +4,7 @@
 // global / local) and the VIO-only reference, N Monte-Carlo runs per cell.
 // Run i of every cell uses simulator seed first_seed + i and the perturbed
 // IMU start of vimot-vio-eval; the target starts from the truth.
+#include <optional>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -66,16 +67,11 @@ int run(int argc, const char* const* argv) {
   const std::string sim_path = args.get("sim-config");
   const std::string vins_path = args.get("vins-config");
   const std::string target_path = args.get("target-config");
-  sim::SimConfig sim_cfg = sim::from_config(Config::load_file(sim_path));
-  if (args.given("duration")) {
-    const double d = args.get_double("duration");
-    if (!(d > 0.0)) throw ArgError("--duration must be > 0, got " + args.get("duration"));
-    sim_cfg.duration = d;
-  }
-  const estimator::VioOptions options = eval::load_vio_options(vins_path);
-  for (const std::string& m : eval::model_mismatches(options, sim_cfg)) {
-    log_warn("estimator model differs from the simulator: ", m);
-  }
+  const eval::EvaluationSetup setup = eval::load_evaluation_setup(
+      sim_path, vins_path, args.given("duration") ? std::optional<double>(args.get_double("duration")) : std::nullopt);
+  for (const std::string& m : setup.model_mismatches) log_warn("estimator model differs from the simulator: ", m);
+  const sim::SimConfig& sim_cfg = setup.sim;
+  const estimator::VioOptions& options = setup.vio;
   const target::TargetFilterOptions base_filter = eval::load_target_filter_options(target_path);
 
   eval::TargetSweepOptions o;

@@ -3,6 +3,7 @@
 // as the `vins` process. Runs are independent std::threads; run i uses
 // simulator seed first_seed + i. Prints a per-run table and the average;
 // --out writes TUM trajectories, per-frame error CSVs and summaries.
+#include <optional>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -61,16 +62,11 @@ int run(int argc, const char* const* argv) {
 
   const std::string sim_path = args.get("sim-config");
   const std::string vins_path = args.get("vins-config");
-  sim::SimConfig sim_cfg = sim::from_config(Config::load_file(sim_path));
-  if (args.given("duration")) {
-    const double d = args.get_double("duration");
-    if (!(d > 0.0)) throw ArgError("--duration must be > 0, got " + args.get("duration"));
-    sim_cfg.duration = d;
-  }
-  const estimator::VioOptions options = eval::load_vio_options(vins_path);
-  for (const std::string& m : eval::model_mismatches(options, sim_cfg)) {
-    log_warn("estimator model differs from the simulator: ", m);
-  }
+  const eval::EvaluationSetup setup = eval::load_evaluation_setup(
+      sim_path, vins_path, args.given("duration") ? std::optional<double>(args.get_double("duration")) : std::nullopt);
+  for (const std::string& m : setup.model_mismatches) log_warn("estimator model differs from the simulator: ", m);
+  const sim::SimConfig& sim_cfg = setup.sim;
+  const estimator::VioOptions& options = setup.vio;
 
   eval::MonteCarloOptions mc;
   const long long runs = args.get_int("runs");
