@@ -4,14 +4,11 @@
 // per processed frame NAV_STATE (nav_state_t, updated = true),
 // TARGET_STATE (target_state_t) and TARGET_PREDICTION (target_prediction_t).
 // All logic is in TargetFilterNode / the target library; this file moves bytes.
-#include <chrono>
 
 #include "common/process/lcm_conversions.h"
 #include "common/process/process.h"
+#include "procs/vins/node_runner.h"
 #include "procs/target_filter/target_filter_node.h"
-#include "vimot/features_t.hpp"
-#include "vimot/ground_truth_t.hpp"
-#include "vimot/imu_t.hpp"
 
 namespace {
 
@@ -45,37 +42,12 @@ int run(int argc, const char* const* argv) {
   callbacks.on_target_prediction = [&](const vimot::TargetPosePrediction& p) {
     process.publish(prediction_channel, vimot::to_lcm(p));
   };
-  callbacks.on_event = [&](const vimot::TargetFilterEvent& e) {
-    switch (e.kind) {
-      case vimot::TargetFilterEvent::Kind::kInfo: vimot::log_info(e.message); break;
-      case vimot::TargetFilterEvent::Kind::kDropped: process.report_dropped(e.message); break;
-      case vimot::TargetFilterEvent::Kind::kError: process.report_error(e.message); break;
-    }
-  };
+  callbacks.on_event = vimot::report_events_to(process);
   vimot::TargetFilterNode node(options, callbacks);
   if (!options.target_enabled) vimot::log_info("target.mode none: VIO only, no target outputs");
-
-  using Clock = std::chrono::steady_clock;
-  Clock::time_point last_imu_wall = Clock::now();
-  process.subscribe<vimot::imu_t>(process.channel("imu", "IMU"), [&](const vimot::imu_t& m) {
-    last_imu_wall = Clock::now();
-    node.on_imu(vimot::from_lcm(m));
-  });
-  process.subscribe<vimot::features_t>(process.channel("features", "FEATURES"),
-                                       [&](const vimot::features_t& m) { node.on_frame(vimot::from_lcm(m)); });
-  // Ground truth also initialises the target (simulation).
-  process.subscribe<vimot::ground_truth_t>(process.channel("ground_truth", "GROUND_TRUTH"),
-                                           [&](const vimot::ground_truth_t& m) {
-                                             node.on_ground_truth(vimot::from_lcm(m));
-                                           });
-  vimot::log_info(options.init_from_ground_truth ? "waiting for GROUND_TRUTH to initialise"
-                                                 : "initialising at rest from the IMU");
-  const int status = process.run([&] {
-    if (std::chrono::duration<double>(Clock::now() - last_imu_wall).count() > max_wait) node.flush();
-  });
-  node.flush();
-  vimot::log_info("processed ", node.frames_processed(), " frames, ", node.resets(), " resets, target ",
-                  node.target_initialized() ? "initialised" : "not initialised");
+  // Ground truth is always subscribed: it also initialises the target (simulation).
+  const int status = vimot::run_estimator_node(process, node, /*use_ground_truth=*/true, max_wait);
+  vimot::log_info("target ", node.target_initialized() ? "initialised" : "not initialised");
   return status;
 }
 

@@ -14,25 +14,13 @@
 #include "common/math/quat.h"
 #include "common/process/lcm_conversions.h"
 #include "common/sim/simulator.h"
+#include "tests/procs/paper_events.h"
 #include "procs/target_filter/target_filter_node.h"
 #include "procs/vins/vins_node.h"
 
 using namespace vimot;
 
 namespace {
-
-std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
-
-std::vector<sim::SimEvent> simulate(double duration) {
-  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
-  cfg.seed = 5;
-  cfg.duration = duration;
-  cfg.ground_truth_events = true;
-  sim::Simulator s(cfg);
-  std::vector<sim::SimEvent> events;
-  s.run([&](const sim::SimEvent& e) { events.push_back(e); });
-  return events;
-}
 
 struct Outputs {
   std::vector<NavState> nav;

@@ -11,23 +11,12 @@
 #include "common/config/config.h"
 #include "common/eval/vins_config.h"
 #include "common/sim/simulator.h"
+#include "tests/procs/paper_events.h"
 #include "procs/vins/vins_node.h"
 
 using namespace vimot;
 
 namespace {
-
-std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
-
-std::vector<sim::SimEvent> simulate(double duration) {
-  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
-  cfg.seed = 5;
-  cfg.duration = duration;
-  sim::Simulator s(cfg);
-  std::vector<sim::SimEvent> events;
-  s.run([&](const sim::SimEvent& e) { events.push_back(e); });
-  return events;
-}
 
 struct Outputs {
   std::vector<NavState> updated;

@@ -1,0 +1,57 @@
+#pragma once
+// The LCM side shared by the estimator processes (vins, target_filter): how
+// a node's events reach the heartbeat counters, and the subscribe → run
+// loop with the bounded IMU wait. A node has on_imu, on_frame,
+// on_ground_truth and flush (VinsNode, TargetFilterNode).
+
+#include <chrono>
+#include <functional>
+
+#include "common/process/lcm_conversions.h"
+#include "common/process/process.h"
+#include "procs/vins/vins_node.h"
+#include "vimot/features_t.hpp"
+#include "vimot/ground_truth_t.hpp"
+#include "vimot/imu_t.hpp"
+
+namespace vimot {
+
+/// Info is logged; dropped input and errors are counted in the heartbeat.
+inline std::function<void(const VinsEvent&)> report_events_to(Process& process) {
+  return [&process](const VinsEvent& e) {
+    switch (e.kind) {
+      case VinsEvent::Kind::kInfo: log_info(e.message); break;
+      case VinsEvent::Kind::kDropped: process.report_dropped(e.message); break;
+      case VinsEvent::Kind::kError: process.report_error(e.message); break;
+    }
+  };
+}
+
+/// Subscribes IMU, FEATURES and (if `use_ground_truth`) GROUND_TRUTH to the
+/// node and handles LCM until stopped. If the IMU stream stops for
+/// `max_wait_s` of wall time, queued frames are processed with the data
+/// there is rather than held forever. Returns the process's exit status.
+template <typename Node>
+int run_estimator_node(Process& process, Node& node, bool use_ground_truth, double max_wait_s) {
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point last_imu_wall = Clock::now();
+  process.subscribe<imu_t>(process.channel("imu", "IMU"), [&](const imu_t& m) {
+    last_imu_wall = Clock::now();
+    node.on_imu(from_lcm(m));
+  });
+  process.subscribe<features_t>(process.channel("features", "FEATURES"),
+                                [&](const features_t& m) { node.on_frame(from_lcm(m)); });
+  if (use_ground_truth) {
+    process.subscribe<ground_truth_t>(process.channel("ground_truth", "GROUND_TRUTH"),
+                                      [&](const ground_truth_t& m) { node.on_ground_truth(from_lcm(m)); });
+  }
+  log_info(use_ground_truth ? "waiting for GROUND_TRUTH to initialise" : "initialising at rest from the IMU");
+  const int status = process.run([&] {
+    if (std::chrono::duration<double>(Clock::now() - last_imu_wall).count() > max_wait_s) node.flush();
+  });
+  node.flush();
+  log_info("processed ", node.frames_processed(), " frames, ", node.resets(), " resets");
+  return status;
+}
+
+}  // namespace vimot
