@@ -8,7 +8,9 @@
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml)
-#   VIMOT_SPEED       simulator real-time factor (default 4)
+#   VIMOT_SPEED       simulator real-time factor (default 4; on 2 cores, 10 is
+#                     too fast for the target filter: UDP drops messages and
+#                     the LCM figures no longer equal the offline ones)
 #   VIMOT_SEED        noise seed (default 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
@@ -19,7 +21,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${VIMOT_BUILD_DIR:-$here/build}"
 
 case "${1:-}" in
-  -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 esac
 
 "$here/scripts/build.sh"
