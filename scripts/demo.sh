@@ -3,8 +3,8 @@
 # Installs what is missing, builds, starts the processes of
 # sheriff_configs/sim_demo.pmd with vimot-sheriff (simulator, vins, the
 # target filter, lcm-logger), and prints a summary: processes, messages per channel, the
-# VIO accuracy of the LCM run against ground truth, the same scenario run
-# offline (in-process, same libraries) for comparison, and the log path.
+# VIO and target accuracy of the LCM run against ground truth, the same scenario
+# run offline (in-process, same libraries) for comparison, and the log path.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml)
@@ -66,5 +66,16 @@ echo "   (offline run of the same scenario and seed: $out/offline.txt)"
 echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal VINS_STATE):"
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE \
   --compare "$out/lcm_summary.json" | sed 's/^/   /'
+echo "== target accuracy of the LCM run (TARGET_STATE vs GROUND_TRUTH), and the offline run:"
+target_cfg="$VIMOT_CONFIG/target_filter.yaml"
+target_key() { sed -n "s/^  $1: *\([a-z0-9.]*\).*/\1/p" "$target_cfg" | head -n 1; }
+"$VIMOT_BIN/vimot-target-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+  --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-config "$target_cfg" \
+  --modes "$(target_key mode)" --representations "$(target_key representation)" \
+  --sigmas "$(target_key sigma_t)" --no-vio-only --runs 1 --first-seed "$VIMOT_SEED" \
+  --perturb-seed "${perturb_seed:-0}" --out "$out/offline_target" --quiet > "$out/offline_target.txt" 2>&1 || true
+"$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE \
+  --compare-target "$out/offline_target/summary.json" | grep -E '^(target|compare|  target)' | sed 's/^/   /'
+echo "   (offline target run: $out/offline_target.txt)"
 echo "== log: $VIMOT_LOG"
 echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"

@@ -47,6 +47,12 @@ ErrorSample error_of(const NavState& est, const GroundTruth& truth) {
                        est.covariance.block<3, 3>(0, 0), est.covariance.block<3, 3>(3, 3));
 }
 
+TargetInImu true_target_in_imu(const GroundTruth& truth) {
+  const Eigen::Matrix3d R_GtoI = quat_to_rot(truth.q_GtoI);
+  return TargetInImu{rot_to_quat(quat_to_rot(truth.q_GtoT) * R_GtoI.transpose()),
+                     R_GtoI * (truth.p_TinG - truth.p_IinG)};
+}
+
 void TrajectoryErrors::add(const ErrorSample& s) {
   sum_sq_p_ += s.err_p.squaredNorm();
   sum_sq_theta_ += s.err_theta.squaredNorm();

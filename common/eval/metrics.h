@@ -52,6 +52,14 @@ ErrorSample compute_error(int64_t utime, const Eigen::Vector4d& q_GtoI_true, con
 /// caller's business): the blocks are covariance [δθ] rows 0–2, [δp] 3–5.
 ErrorSample error_of(const NavState& estimate, const GroundTruth& truth);
 
+/// The true target pose in the IMU frame [q_ItoT, p_TinI] of a GroundTruth
+/// with has_target.
+struct TargetInImu {
+  Eigen::Vector4d q_ItoT;
+  Eigen::Vector3d p_TinI;
+};
+TargetInImu true_target_in_imu(const GroundTruth& truth);
+
 /// Root-mean-square errors and average NEES of one trajectory.
 struct ErrorSummary {
   double rmse_position_m{0.0};       // √(Σ|δp|² / n)

@@ -112,7 +112,8 @@ target::TargetFilterOptions load_target_filter_options(const std::string& path) 
 
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                                   const std::optional<target::TargetFilterOptions>& filter_options,
-                                  uint64_t perturb_seed, const std::function<void(double)>& progress) {
+                                  uint64_t perturb_seed, const std::function<void(double)>& progress,
+                                  bool keep_samples) {
   const auto wall_start = std::chrono::steady_clock::now();
   sim::SimConfig cfg = sim_config;
   cfg.ground_truth_events = true;
@@ -126,7 +127,11 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   const InitialEstimate x0 = initial_estimate(sim.initial_state(), options, perturb_seed);
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
   std::unique_ptr<target::TargetFilter> filter;
-  if (filter_options) filter = std::make_unique<target::TargetFilter>(est, *filter_options);
+  if (filter_options) {
+    target::TargetFilterOptions f = *filter_options;
+    f.init_perturb_seed = perturb_seed;  // the target starts perturbed like the robot
+    filter = std::make_unique<target::TargetFilter>(est, f);
+  }
 
   TrajectoryErrors e_ti, e_tg, e_imu;
   GroundTruth truth;
@@ -178,14 +183,17 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
           x_i = target::global_to_local(ip, x);
           P_i = target::global_to_local_covariance(ip, x, P18);
         }
-        const Eigen::Matrix3d R_GtoI = quat_to_rot(truth.q_GtoI);
-        const Eigen::Matrix3d R_GtoT = quat_to_rot(truth.q_GtoT);
-        const Eigen::Vector4d q_ItoT_true = rot_to_quat(R_GtoT * R_GtoI.transpose());
-        const Eigen::Vector3d p_TinI_true = R_GtoI * (truth.p_TinG - truth.p_IinG);
-        e_ti.add(compute_error(frame.utime, q_ItoT_true, p_TinI_true, x_i.q_RtoT, x_i.p_TinR, P_i.block<3, 3>(0, 0),
-                               P_i.block<3, 3>(3, 3)));
-        e_tg.add(compute_error(frame.utime, truth.q_GtoT, truth.p_TinG, x_g.q_RtoT, x_g.p_TinR,
-                               P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3)));
+        const TargetInImu truth_in_imu = true_target_in_imu(truth);
+        const ErrorSample ti = compute_error(frame.utime, truth_in_imu.q_ItoT, truth_in_imu.p_TinI, x_i.q_RtoT, x_i.p_TinR,
+                                             P_i.block<3, 3>(0, 0), P_i.block<3, 3>(3, 3));
+        const ErrorSample tg = compute_error(frame.utime, truth.q_GtoT, truth.p_TinG, x_g.q_RtoT, x_g.p_TinR,
+                                             P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3));
+        e_ti.add(ti);
+        e_tg.add(tg);
+        if (keep_samples) {
+          r.target_in_imu_samples.push_back(ti);
+          r.target_in_world_samples.push_back(tg);
+        }
       }
     } catch (const std::invalid_argument& e) {
       r.diverged = true;
@@ -262,7 +270,9 @@ std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estim
         cfg.seed = seed;
         std::optional<TargetFilterOptions> f;
         if (!c.vio_only) f = c.filter;
-        c.runs[static_cast<std::size_t>(i)] = run_target_on_sim(cfg, options, f, perturb_seed_for_run(seed), fr);
+        c.runs[static_cast<std::size_t>(i)] =
+            run_target_on_sim(cfg, options, f, o.fixed_perturb_seed.value_or(perturb_seed_for_run(seed)), fr,
+                              o.keep_samples);
       },
       progress);
   return cells;

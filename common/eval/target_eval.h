@@ -60,13 +60,17 @@ struct TargetRunResult {
   bool diverged{false};
   std::string divergence_reason;
   double wall_s{0.0};
+  /// Per-frame errors with 3σ bounds (only when asked for: keep_samples).
+  std::vector<ErrorSample> target_in_imu_samples;
+  std::vector<ErrorSample> target_in_world_samples;
 };
 
 /// One run on `sim_config` (its seed and duration); filter == nullopt: VIO
-/// only. `progress` gets the fraction of camera frames done.
+/// only. `progress` gets the fraction of camera frames done. keep_samples:
+/// also return the per-frame target errors.
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                                   const std::optional<target::TargetFilterOptions>& filter, uint64_t perturb_seed,
-                                  const std::function<void(double)>& progress = {});
+                                  const std::function<void(double)>& progress = {}, bool keep_samples = false);
 
 /// One cell of the sweep: a filter configuration (or VIO only) × runs.
 struct TargetCell {
@@ -94,6 +98,10 @@ struct TargetSweepOptions {
   int runs{30};
   uint64_t first_seed{1};
   int threads{0};
+  bool keep_samples{false};  // TargetRunResult::*_samples of every run
+  /// Perturbation seed of every run instead of perturb_seed_for_run (0 =
+  /// start at the truth), e.g. the vins config's, to reproduce an LCM run.
+  std::optional<uint64_t> fixed_perturb_seed;
 };
 
 /// Every cell (VIO only first, then modes × representations × sigmas in

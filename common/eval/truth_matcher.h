@@ -12,6 +12,7 @@
 #include "common/eval/metrics.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
+#include "common/types/target_state.h"
 
 namespace vimot {
 namespace eval {
@@ -27,22 +28,39 @@ struct MatchCounts {
   int64_t bad_covariance{0};    // matched, but a 3×3 block not positive definite (skipped)
 };
 
+struct TargetMatchCounts {
+  int64_t states{0};
+  int64_t duplicate_states{0};  // at a utime already seen (first kept)
+  int64_t matched{0};           // with truth carrying the target at the same utime
+  int64_t unmatched{0};
+  int64_t bad_covariance{0};    // matched, but a 3×3 block not positive definite (skipped)
+};
+
+/// Target errors in both frames, as vimot-target-eval's (run_target_on_sim).
+/// A published target state carries the covariance of the filter's
+/// representation only, so NEES and 3σ are filled in that frame and NaN in
+/// the other (its covariance needs the robot's, which is not published).
+struct TargetMatch {
+  std::vector<ErrorSample> target_in_imu;    // [q_ItoT, p_TinI]
+  std::vector<ErrorSample> target_in_world;  // [q_GtoT, p_TinG]
+};
+
 class TruthMatcher {
  public:
   void add_state(const NavState& state);
+  void add_target(const TargetStateEstimate& target);
   void add_truth(const GroundTruth& truth);
 
   /// Matches everything given so far; samples in utime order.
   std::vector<ErrorSample> match(MatchCounts* counts) const;
+  TargetMatch match_targets(TargetMatchCounts* counts) const;
 
  private:
-  struct Pose {
-    Eigen::Vector4d q_GtoI;
-    Eigen::Vector3d p_IinG;
-  };
   std::map<int64_t, NavState> states_;  // updated states by utime
-  std::map<int64_t, Pose> truths_;
+  std::map<int64_t, TargetStateEstimate> targets_;
+  std::map<int64_t, GroundTruth> truths_;
   MatchCounts counts_;
+  TargetMatchCounts target_counts_;
 };
 
 }  // namespace eval

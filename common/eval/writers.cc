@@ -1,5 +1,6 @@
 #include "common/eval/writers.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -107,13 +108,19 @@ void write_summary_json(JsonWriter& json, const ErrorSummary& s) {
 }
 
 ErrorSummary read_summary_json(const std::string& path, const std::string& key) {
-  std::ifstream f(path);
-  if (!f) throw std::runtime_error("cannot read '" + path + "'");
-  std::stringstream text;
-  text << f.rdbuf();
+  const std::string text = read_text_file(path);
   try {
-    const JsonValue doc = JsonValue::parse(text.str());
-    const JsonValue& o = doc.at(key);
+    const JsonValue doc = JsonValue::parse(text);
+    const JsonValue* node = &doc;
+    std::size_t begin = 0;
+    while (begin <= key.size()) {
+      const std::size_t end = std::min(key.find('/', begin), key.size());
+      const std::string part = key.substr(begin, end - begin);
+      const bool index = !part.empty() && part.find_first_not_of("0123456789") == std::string::npos;
+      node = index && !node->is_object() ? &node->at(static_cast<std::size_t>(std::stoul(part))) : &node->at(part);
+      begin = end + 1;
+    }
+    const JsonValue& o = *node;
     ErrorSummary s;
     s.rmse_position_m = o.at("rmse_position_m").number();
     s.rmse_orientation_deg = o.at("rmse_orientation_deg").number();
@@ -124,6 +131,14 @@ ErrorSummary read_summary_json(const std::string& path, const std::string& key) 
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("'" + path + "' (object '" + key + "'): " + e.what());
   }
+}
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error("cannot read '" + path + "'");
+  std::stringstream text;
+  text << f.rdbuf();
+  return text.str();
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

@@ -54,8 +54,12 @@ std::vector<ErrorSample> errors_of(const std::vector<FrameSample>& samples);
 void write_summary_json(JsonWriter& json, const ErrorSummary& summary);
 
 /// Reads the object at `key` of a JSON file written with write_summary_json
-/// (e.g. key "summary"). Throws std::runtime_error naming the file and key.
+/// (e.g. key "summary"; a path "cells/1/per_run/0/target_in_imu" walks
+/// objects and arrays). Throws std::runtime_error naming the file and key.
 ErrorSummary read_summary_json(const std::string& path, const std::string& key = "summary");
+
+/// The whole file; throws std::runtime_error naming it if it cannot be read.
+std::string read_text_file(const std::string& path);
 
 /// Writes `text` to `path`, throwing std::runtime_error on failure.
 void write_text_file(const std::string& path, const std::string& text);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <random>
 #include <set>
 #include <stdexcept>
 
@@ -24,6 +25,32 @@ using estimator::StateHelper;
 using estimator::TypePtr;
 
 // ---------------------------------------------------------------- TargetState
+namespace {
+
+PoseValue pose_of(const estimator::PoseJPL& pose) { return PoseValue{pose.quat(), pose.pos()}; }
+PoseValue fej_pose_of(const estimator::PoseJPL& pose) { return PoseValue{pose.fej().head<4>(), pose.pos_fej()}; }
+
+// The prediction z at the current estimates with the Jacobians at the first
+// estimates (FEJ): linearising every measurement of the target pose and its
+// points at one point keeps the unobservable directions (target yaw and
+// origin vs its points) unobservable; current-estimate Jacobians would let
+// the filter gain spurious information along them.
+TargetPointPrediction predict_fej(TargetRepresentation representation, const estimator::PoseJPL& imu_pose,
+                                  const estimator::PoseJPL& target_pose, const Eigen::Vector3d& p_FinT,
+                                  const Eigen::Vector3d& p_FinT_fej, const CameraExtrinsics& cam, bool use_fej) {
+  TargetPointPrediction pred = predict_target_point(representation, pose_of(imu_pose), pose_of(target_pose), p_FinT, cam);
+  if (!use_fej) return pred;
+  const TargetPointPrediction lin =
+      predict_target_point(representation, fej_pose_of(imu_pose), fej_pose_of(target_pose), p_FinT_fej, cam);
+  pred.valid = pred.valid && lin.valid;
+  pred.H_imu_pose = lin.H_imu_pose;
+  pred.H_target_pose = lin.H_target_pose;
+  pred.H_point = lin.H_point;
+  return pred;
+}
+
+}  // namespace
+
 TargetState::TargetState()
     : Type(12), pose_(std::make_shared<PoseJPL>()), v_(std::make_shared<estimator::Vec>(3)),
       w_(std::make_shared<estimator::Vec>(3)) {
@@ -79,6 +106,7 @@ bool TargetState::contains(const estimator::Type* other) const {
 }
 
 TargetValue TargetState::get() const { return TargetValue::from_vector(value_); }
+TargetValue TargetState::get_fej() const { return TargetValue::from_vector(fej_); }
 
 // ---------------------------------------------------------------- options
 const char* to_string(TargetUpdateMode mode) {
@@ -155,8 +183,17 @@ bool TargetFilter::propagate_jointly(const State& state, const estimator::ImuVal
                                      Eigen::MatrixXd* Q) {
   if (!target_) return false;
   const double dt = utime_to_seconds(t1 - t0);
-  const TargetStep step =
-      propagate_target(options_.representation, target_->get(), x0, x1, Phi_II, Q_II, dt, noise_);
+  TargetStep step = propagate_target(options_.representation, target_->get(), x0, x1, Phi_II, Q_II, dt, noise_);
+  if (state.options().use_fej) {
+    // Φ and Q at the first estimates of the target and IMU at t_k (x1 is its own
+    // first estimate), as the estimator's own IMU Φ_II.
+    const TargetStep lin = propagate_target(options_.representation, target_->get_fej(), state.imu()->get_fej(), x1,
+                                            Phi_II, Q_II, dt, noise_);
+    step.Phi_TT = lin.Phi_TT;
+    step.Phi_TI = lin.Phi_TI;
+    step.Q_TT = lin.Q_TT;
+    step.Q_TI = lin.Q_TI;
+  }
   Eigen::Matrix<double, 27, 27> F, Qd;
   joint_transition(Phi_II, Q_II, step, &F, &Qd);
   *order = {state.imu(), target_};
@@ -202,12 +239,20 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
   }
   target_ = std::make_shared<TargetState>();
   target_->set_value(x.to_vector());
-  target_->set_fej(x.to_vector());
   const TargetInitSigmas& s = options_.init_sigmas;
-  Vector12d d;
-  d << Eigen::Vector3d::Constant(s.theta * s.theta), Eigen::Vector3d::Constant(s.p * s.p),
-      Eigen::Vector3d::Constant(s.v * s.v), Eigen::Vector3d::Constant(s.w * s.w);
-  StateHelper::add_variable(state, target_, Eigen::MatrixXd(d.asDiagonal()));
+  Vector12d sigma;
+  sigma << Eigen::Vector3d::Constant(s.theta), Eigen::Vector3d::Constant(s.p), Eigen::Vector3d::Constant(s.v),
+      Eigen::Vector3d::Constant(s.w);
+  if (options_.init_perturb_seed != 0) {
+    // Its own stream: the IMU start perturbation uses the same seed.
+    std::mt19937_64 rng(options_.init_perturb_seed ^ 0x7461726765740000ull);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    Vector12d dx;
+    for (int i = 0; i < 12; ++i) dx(i) = sigma(i) * n01(rng);
+    target_->update(dx);
+  }
+  target_->set_fej(target_->value());
+  StateHelper::add_variable(state, target_, Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()));
   if (state.clone_at(utime)) on_clone_added(state, utime);
   return true;
 }
@@ -307,8 +352,7 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
     if (o.camera_id < 0 || o.camera_id >= static_cast<int>(cameras.size())) continue;
     by_point[o.feature_id].push_back(&o);
   }
-  const PoseValue imu_pose{state.imu()->pose()->quat(), state.imu()->pose()->pos()};
-  const PoseValue tgt_pose{target_->pose()->quat(), target_->pose()->pos()};
+  const bool use_fej = state.options().use_fej;
   struct Block {
     TypePtr point;
     Eigen::MatrixXd H;  // [target pose (6), IMU pose (6, global), point (3)]
@@ -319,6 +363,7 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
   for (const auto& kv : by_point) {
     TargetPoint& pt = points_.at(kv.first);
     const Eigen::Vector3d p_FinT = pt.var->value();
+    const Eigen::Vector3d p_FinT_fej = pt.var->fej();
     const int m = static_cast<int>(kv.second.size());
     const int nx = global ? 15 : 9;
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(2 * m, nx);
@@ -326,8 +371,8 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
     int row = 0;
     for (const FeatureObservation* o : kv.second) {
       const estimator::CameraInfo& cam = cameras[static_cast<size_t>(o->camera_id)];
-      const TargetPointPrediction pred =
-          predict_target_point(options_.representation, imu_pose, tgt_pose, p_FinT, CameraExtrinsics{cam.R_ItoC, cam.p_IinC});
+      const TargetPointPrediction pred = predict_fej(options_.representation, *state.imu()->pose(), *target_->pose(),
+                                                     p_FinT, p_FinT_fej, CameraExtrinsics{cam.R_ItoC, cam.p_IinC}, use_fej);
       if (!pred.valid) continue;
       const Eigen::Matrix2d W = cam.whitening(o->normalized);
       H.block<2, 6>(row, 0) = W * pred.H_target_pose;
@@ -436,9 +481,8 @@ void TargetFilter::initialize_points(State& state, int64_t utime) {
       for (const auto& o : kv.second) {
         const auto tclone = clones_.at(o.utime);
         const auto iclone = state.clone_at(o.utime);
-        const TargetPointPrediction pred = predict_target_point(
-            options_.representation, PoseValue{iclone->quat(), iclone->pos()}, PoseValue{tclone->quat(), tclone->pos()},
-            p_FinT, ext);
+        const TargetPointPrediction pred = predict_fej(options_.representation, *iclone, *tclone, p_FinT, p_FinT, ext,
+                                                       state.options().use_fej);
         if (!pred.valid) ok = false;
         const Eigen::Matrix2d W = cam.whitening(o.uv);
         H_R.block<2, 6>(row, layout.col(tclone)) = W * pred.H_target_pose;
@@ -536,10 +580,8 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
       for (const auto& o : kv.second) {
         const auto tclone = clones_.at(o.utime);
         const auto iclone = state.clone_at(o.utime);
-        const PoseValue imu_pose{iclone->quat(), iclone->pos()};
-        const PoseValue tgt_pose{tclone->quat(), tclone->pos()};
-        const TargetPointPrediction pred =
-            predict_target_point(options_.representation, imu_pose, tgt_pose, p_FinT, ext);
+        const TargetPointPrediction pred = predict_fej(options_.representation, *iclone, *tclone, p_FinT, p_FinT, ext,
+                                                       state.options().use_fej);
         if (!pred.valid) ok = false;
         const Eigen::Matrix2d W = cam.whitening(o.uv);
         H_x.block<2, 6>(row, layout.col(tclone)) = W * pred.H_target_pose;

@@ -80,6 +80,7 @@ class TargetState : public estimator::Type {
   bool contains(const estimator::Type* other) const override;
 
   TargetValue get() const;
+  TargetValue get_fej() const;
   std::shared_ptr<estimator::PoseJPL> pose() const { return pose_; }
   std::shared_ptr<estimator::Vec> v() const { return v_; }
   std::shared_ptr<estimator::Vec> w() const { return w_; }
@@ -106,6 +107,9 @@ struct TargetFilterOptions {
   double sigma_t{0.05};   // target noise density (v: m/s²/√Hz, w: rad/s²/√Hz)
   bool planar{true};      // only v_x, v_y, w_z driven (paper Sec. IV)
   TargetInitSigmas init_sigmas;
+  /// The initialisation from the truth (simulation) draws its error from the
+  /// init_sigmas prior with this seed, so the prior is honest; 0 = no error.
+  uint64_t init_perturb_seed{0};
   double chi2_multiplier{1.0};
   int min_clone_times{2};
   // Target points in the state (0 disables them: MSCKF-only target updates).

@@ -3,6 +3,9 @@
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
 
+#include "common/eval/json.h"
+#include "common/eval/writers.h"
+
 #include "common/process/lcm_conversions.h"
 
 namespace vimot {
@@ -27,6 +30,19 @@ bool decode(const lcm::LogEvent& ev, Msg* msg, std::string* why) {
 }
 
 }  // namespace
+
+int first_target_cell_index(const std::string& summary_json) {
+  const JsonValue doc = JsonValue::parse(read_text_file(summary_json));
+  const JsonValue& cells = doc.at("cells");
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    if (cells.at(i).at("mode").string() == "vio") continue;
+    if (cells.at(i).at("runs").number() != 1.0) {
+      throw std::runtime_error("'" + summary_json + "': compare needs a one-run summary (vimot-target-eval --runs 1)");
+    }
+    return static_cast<int>(i);
+  }
+  throw std::runtime_error("'" + summary_json + "' has no target-filter cell");
+}
 
 LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& options) {
   lcm::LogFile log(path, "r");
@@ -54,6 +70,17 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
       } catch (const std::invalid_argument& e) {
         malformed(&r.malformed_states, *ev, e.what());
       }
+    } else if (!options.target_channel.empty() && ev->channel == options.target_channel) {
+      target_state_t msg;
+      if (!decode(*ev, &msg, &why)) {
+        malformed(&r.malformed_targets, *ev, why);
+        continue;
+      }
+      try {
+        matcher.add_target(from_lcm(msg));
+      } catch (const std::invalid_argument& e) {
+        malformed(&r.malformed_targets, *ev, e.what());
+      }
     } else if (ev->channel == options.truth_channel) {
       ground_truth_t msg;
       if (!decode(*ev, &msg, &why)) {
@@ -71,6 +98,14 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   TrajectoryErrors errors;
   for (const ErrorSample& s : r.samples) errors.add(s);
   r.summary = errors.summary();
+  if (!options.target_channel.empty()) {
+    r.target_samples = matcher.match_targets(&r.target_counts);
+    TrajectoryErrors in_imu, in_world;
+    for (const ErrorSample& s : r.target_samples.target_in_imu) in_imu.add(s);
+    for (const ErrorSample& s : r.target_samples.target_in_world) in_world.add(s);
+    r.target_in_imu = in_imu.summary();
+    r.target_in_world = in_world.summary();
+  }
   return r;
 }
 

@@ -20,6 +20,7 @@ namespace eval {
 struct LogEvalOptions {
   std::string state_channel{"VINS_STATE"};
   std::string truth_channel{"GROUND_TRUTH"};
+  std::string target_channel;  // target_state_t; empty: no target evaluation
 };
 
 struct LogEvalResult {
@@ -30,7 +31,18 @@ struct LogEvalResult {
   int64_t malformed_states{0};       // on state_channel, not a valid nav_state_t
   int64_t malformed_truths{0};       // on truth_channel, not a valid ground_truth_t
   std::string first_malformed;       // what was wrong with the first one
+  // Target (target_channel given): errors in both frames, see TargetMatch.
+  ErrorSummary target_in_imu;
+  ErrorSummary target_in_world;
+  TargetMatch target_samples;
+  TargetMatchCounts target_counts;
+  int64_t malformed_targets{0};
 };
+
+/// Index in "cells" of the first target-filter cell (not VIO-only) of a
+/// vimot-target-eval summary.json made with --runs 1. Throws
+/// std::runtime_error if there is none or it has more than one run.
+int first_target_cell_index(const std::string& summary_json);
 
 /// Throws std::runtime_error if the log cannot be opened.
 LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& options = {});

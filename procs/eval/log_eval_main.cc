@@ -28,11 +28,18 @@ int run(int argc, const char* const* argv) {
                  "log: states with updated = true, truth at exactly the same utime. Prints position\n"
                  "RMSE [m], orientation RMSE [deg], average NEES of position and orientation (ideal 3)\n"
                  "and the sample count. Malformed messages are counted and skipped.\n"
+                 "With --target-channel also the target filter's target_state_t: the target pose in\n"
+                 "the IMU frame and in the world (NEES only in the filter's representation: the log\n"
+                 "carries only that covariance).\n"
                  "Exit status: 0; 2 if no state could be matched; 3 if --tolerance is exceeded;\n"
                  "1 on bad input.");
   args.set_positional("LOG", "LCM log file", 1, 1);
   args.add_option("state-channel", "CHANNEL", "nav_state_t channel", "VINS_STATE");
   args.add_option("truth-channel", "CHANNEL", "ground_truth_t channel", "GROUND_TRUTH");
+  args.add_option("target-channel", "CHANNEL", "target_state_t channel to evaluate too (e.g. TARGET_STATE)");
+  args.add_option("compare-target", "SUMMARY_JSON",
+                  "with --target-channel: print the relative difference of the target figures to a\n"
+                  "one-run vimot-target-eval summary.json (its first target-filter cell)");
   args.add_option("json", "FILE", "write the summary as JSON (object \"summary\", as vimot-vio-eval's)");
   args.add_option("csv", "FILE", "write the per-sample errors with 3-sigma bounds (as vimot-vio-eval's)");
   args.add_option("compare", "SUMMARY_JSON", "print the relative difference to this summary (e.g. an offline run)");
@@ -43,6 +50,10 @@ int run(int argc, const char* const* argv) {
   eval::LogEvalOptions opt;
   opt.state_channel = args.get("state-channel");
   opt.truth_channel = args.get("truth-channel");
+  opt.target_channel = args.get("target-channel");
+  if (args.given("compare-target") && opt.target_channel.empty()) {
+    throw ArgError("--compare-target needs --target-channel");
+  }
   const eval::LogEvalResult r = eval::evaluate_log(path, opt);
   const eval::MatchCounts& c = r.counts;
 
@@ -81,26 +92,65 @@ int run(int argc, const char* const* argv) {
   }
   if (args.given("csv")) eval::write_errors_csv(args.get("csv"), r.samples);
 
+  if (!opt.target_channel.empty()) {
+    const eval::TargetMatchCounts& tc = r.target_counts;
+    std::printf("target states on %s: %lld (duplicate %lld, malformed %lld), matched %lld, without truth %lld, "
+                "covariance not positive definite %lld\n",
+                opt.target_channel.c_str(), static_cast<long long>(tc.states),
+                static_cast<long long>(tc.duplicate_states), static_cast<long long>(r.malformed_targets),
+                static_cast<long long>(tc.matched), static_cast<long long>(tc.unmatched),
+                static_cast<long long>(tc.bad_covariance));
+    for (const auto& [name, ts] : {std::pair<const char*, const eval::ErrorSummary&>{"in IMU  ", r.target_in_imu},
+                                   std::pair<const char*, const eval::ErrorSummary&>{"in world", r.target_in_world}}) {
+      std::printf("target %s: position RMSE %.5f m  orientation RMSE %.4f deg  NEES position %.2f  orientation %.2f\n",
+                  name, ts.rmse_position_m, ts.rmse_orientation_deg, ts.nees_position, ts.nees_orientation);
+    }
+  }
+
   int status = s.count > 0 ? 0 : 2;
-  if (args.given("compare")) {
-    const eval::ErrorSummary o = eval::read_summary_json(args.get("compare"));
-    const double tol = args.given("tolerance") ? args.get_double("tolerance") : -1.0;
-    struct Row {
-      const char* name;
-      double log, offline;
-    } rows[] = {{"position RMSE [m]", s.rmse_position_m, o.rmse_position_m},
-                {"orientation RMSE [deg]", s.rmse_orientation_deg, o.rmse_orientation_deg},
-                {"NEES position", s.nees_position, o.nees_position},
-                {"NEES orientation", s.nees_orientation, o.nees_orientation},
-                {"samples", static_cast<double>(s.count), static_cast<double>(o.count)}};
-    std::printf("compare with %s:\n  %-24s %14s %14s %12s\n", args.get("compare").c_str(), "", "this log", "reference",
+  if (!opt.target_channel.empty() && r.target_in_imu.count == 0) status = 2;
+  const double tol = args.given("tolerance") ? args.get_double("tolerance") : -1.0;
+  struct Row {
+    const char* name;
+    double log, offline;
+  };
+  auto print_compare = [&](const std::string& reference, const std::vector<Row>& rows) {
+    std::printf("compare with %s:\n  %-32s %14s %14s %12s\n", reference.c_str(), "", "this log", "reference",
                 "rel. diff");
     for (const Row& row : rows) {
+      if (std::isnan(row.log) && std::isnan(row.offline)) continue;
       const double d = relative_difference(row.log, row.offline);
-      std::printf("  %-24s %14.6g %14.6g %12.3e%s\n", row.name, row.log, row.offline, d,
+      std::printf("  %-32s %14.6g %14.6g %12.3e%s\n", row.name, row.log, row.offline, d,
                   tol >= 0.0 && d > tol ? "  > tolerance" : "");
       if (tol >= 0.0 && !(d <= tol)) status = 3;
     }
+  };
+  if (args.given("compare")) {
+    const eval::ErrorSummary o = eval::read_summary_json(args.get("compare"));
+    print_compare(args.get("compare"),
+                  {{"position RMSE [m]", s.rmse_position_m, o.rmse_position_m},
+                   {"orientation RMSE [deg]", s.rmse_orientation_deg, o.rmse_orientation_deg},
+                   {"NEES position", s.nees_position, o.nees_position},
+                   {"NEES orientation", s.nees_orientation, o.nees_orientation},
+                   {"samples", static_cast<double>(s.count), static_cast<double>(o.count)}});
+  }
+  if (args.given("compare-target")) {
+    const std::string ref = args.get("compare-target");
+    const std::string cell = "cells/" + std::to_string(eval::first_target_cell_index(ref)) + "/per_run/0/";
+    const eval::ErrorSummary oi = eval::read_summary_json(ref, cell + "target_in_imu");
+    const eval::ErrorSummary ow = eval::read_summary_json(ref, cell + "target_in_world");
+    const eval::ErrorSummary& li = r.target_in_imu;
+    const eval::ErrorSummary& lw = r.target_in_world;
+    const bool local = std::isnan(lw.nees_position);  // NEES only in the filter's representation
+    const eval::ErrorSummary& ln = local ? li : lw;
+    const eval::ErrorSummary& on = local ? oi : ow;
+    print_compare(ref, {{"target in IMU position RMSE [m]", li.rmse_position_m, oi.rmse_position_m},
+                        {"target in IMU orientation [deg]", li.rmse_orientation_deg, oi.rmse_orientation_deg},
+                        {"target in world position [m]", lw.rmse_position_m, ow.rmse_position_m},
+                        {"target in world orientation [deg]", lw.rmse_orientation_deg, ow.rmse_orientation_deg},
+                        {"target NEES position", ln.nees_position, on.nees_position},
+                        {"target NEES orientation", ln.nees_orientation, on.nees_orientation},
+                        {"target samples", static_cast<double>(li.count), static_cast<double>(oi.count)}});
   }
   return status;
 }

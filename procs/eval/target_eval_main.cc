@@ -58,6 +58,13 @@ int run(int argc, const char* const* argv) {
   args.add_option("threads", "K", "parallel runs (0 = hardware concurrency)", "0");
   args.add_option("duration", "SECONDS", "simulate only this long (default: the config's)");
   args.add_option("out", "DIR", "write summary.json and summary.csv");
+  args.add_option("perturb-seed", "P",
+                  "perturbation seed of the start for every run instead of one derived from the simulator\n"
+                  "seed (e.g. the vins config's init.perturb_seed, to reproduce an LCM run); 0 = the truth");
+  args.add_flag("errors",
+                "with --out: also write every run's per-frame target errors with 3σ bounds\n"
+                "(DIR/errors/<mode>_<repr>_<σ_t>_seedNNN_target_in_{imu,world}.csv, the columns of\n"
+                "vimot-vio-eval's errors.csv, for scripts/plot_errors.py)");
   args.add_flag("quiet", "no progress bar");
   args.add_option("log-level", "LEVEL", "debug|info|warn|error", "warn");
   if (!args.parse(argc, argv)) return 0;
@@ -117,6 +124,13 @@ int run(int argc, const char* const* argv) {
   if (n_cells == 0) throw ArgError("nothing to run (empty --sigmas/--modes/--representations and --no-vio-only)");
   const std::string out_dir = args.get("out");
   if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
+  if (args.flag("errors") && out_dir.empty()) throw ArgError("--errors needs --out DIR");
+  o.keep_samples = args.flag("errors");
+  if (args.given("perturb-seed")) {
+    const long long p = args.get_int("perturb-seed");
+    if (p < 0) throw ArgError("--perturb-seed must be >= 0, got " + args.get("perturb-seed"));
+    o.fixed_perturb_seed = static_cast<uint64_t>(p);
+  }
 
   std::fprintf(stderr, "vimot-target-eval: %zu cells x %d runs on %d threads (%s, %s, %s)\n", n_cells, o.runs,
                o.threads, sim_path.c_str(), vins_path.c_str(), target_path.c_str());
@@ -140,6 +154,23 @@ int run(int argc, const char* const* argv) {
                           eval::target_summary_json(cells, sim_path, vins_path, target_path, o, wall));
     eval::write_text_file(out_dir + "/summary.csv", eval::target_summary_csv(cells));
     std::cout << "wrote " << out_dir << "/{summary.json, summary.csv}\n";
+    if (o.keep_samples) {
+      std::filesystem::create_directories(out_dir + "/errors");
+      for (const eval::TargetCell& c : cells) {
+        if (c.vio_only) continue;
+        char cell_name[64];
+        std::snprintf(cell_name, sizeof(cell_name), "%s_%s_%g", target::to_string(c.filter.mode),
+                      target::to_string(c.filter.representation), c.filter.sigma_t);
+        for (const eval::TargetRunResult& r : c.runs) {
+          char prefix[128];
+          std::snprintf(prefix, sizeof(prefix), "%s/errors/%s_seed%03llu_target_in_", out_dir.c_str(), cell_name,
+                        static_cast<unsigned long long>(r.sim_seed));
+          eval::write_errors_csv(std::string(prefix) + "imu.csv", r.target_in_imu_samples);
+          eval::write_errors_csv(std::string(prefix) + "world.csv", r.target_in_world_samples);
+        }
+      }
+      std::cout << "wrote " << out_dir << "/errors/*.csv\n";
+    }
   }
   return diverged > 0 ? 2 : 0;
 }

@@ -141,7 +141,12 @@ TargetFilterNode::TargetFilterNode(const TargetFilterNodeOptions& options, Callb
           [this](const VinsEvent& e) {
             if (callbacks_.on_event) callbacks_.on_event(e);
           }) {
-  if (options_.target_enabled) filter_ = std::make_unique<target::TargetFilter>(vins_.mutable_estimator(), options_.target);
+  if (options_.target_enabled) {
+    // The target starts from the truth with the robot's perturbation seed, as in vimot-target-eval.
+    target::TargetFilterOptions target = options_.target;
+    target.init_perturb_seed = options_.perturb_seed;
+    filter_ = std::make_unique<target::TargetFilter>(vins_.mutable_estimator(), target);
+  }
   vins_.set_frame_hooks([this](const CameraFrame& frame) { before_frame(frame); }, [this] { after_update(); });
 }
 

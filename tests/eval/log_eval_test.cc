@@ -169,6 +169,69 @@ TEST_CASE("Log evaluation: known errors, updated states only, corrupt messages c
   std::remove(path.c_str());
 }
 
+TEST_CASE("Log evaluation of target states: both frames, NEES in the filter's representation", "[eval][log]") {
+  // Truth: robot at truth_at(t), target 5 m ahead in I, yawed by 0.3 rad.
+  auto truth_with_target = [](int64_t utime) {
+    GroundTruth gt = truth_at(utime);
+    gt.has_target = true;
+    const Eigen::Matrix3d R_GtoI = quat_to_rot(gt.q_GtoI);
+    const Eigen::Matrix3d R_ItoT = exp_so3(Eigen::Vector3d(0, 0, 0.3)).transpose();
+    gt.q_GtoT = rot_to_quat(R_ItoT * R_GtoI);
+    gt.p_TinG = gt.p_IinG + R_GtoI.transpose() * Eigen::Vector3d(5, 0, 0);
+    return gt;
+  };
+  // A local estimate with errors (truth − estimate) err_p in I and err_theta
+  // in T; the world pose derived with the true robot pose, so its errors are
+  // err_p rotated into G and the same err_theta.
+  auto target_at = [&](int64_t utime, const Eigen::Vector3d& err_p, const Eigen::Vector3d& err_theta, double sigma) {
+    const GroundTruth gt = truth_with_target(utime);
+    const eval::TargetInImu t = true_target_in_imu(gt);
+    TargetStateEstimate e;
+    e.utime = utime;
+    e.representation = TargetFrame::kLocal;
+    e.p_TinI = t.p_TinI - err_p;
+    e.q_ItoT = rot_to_quat(exp_so3(err_theta) * quat_to_rot(t.q_ItoT));
+    const Eigen::Matrix3d R_GtoI = quat_to_rot(gt.q_GtoI);
+    e.p_TinG = gt.p_IinG + R_GtoI.transpose() * e.p_TinI;
+    e.q_GtoT = rot_to_quat(quat_to_rot(e.q_ItoT) * R_GtoI);
+    e.covariance = sigma * sigma * Eigen::Matrix<double, 12, 12>::Identity();
+    return e;
+  };
+  const std::string path = temp_path("target");
+  {
+    LogWriter w(path);
+    for (int64_t t = 100; t <= 300; t += 100) w.write("GROUND_TRUTH", to_lcm(truth_with_target(t)), t);
+    w.write("GROUND_TRUTH", to_lcm(truth_at(400)), 400);  // no target in the truth
+    w.write("TARGET_STATE", to_lcm(target_at(100, Eigen::Vector3d(0.03, 0, 0), Eigen::Vector3d(0, 0, 0.02), 0.01)), 100);
+    w.write("TARGET_STATE", to_lcm(target_at(200, Eigen::Vector3d(0, 0, 0.04), Eigen::Vector3d(0.02, 0, 0), 0.02)), 200);
+    w.write("TARGET_STATE", to_lcm(target_at(200, Eigen::Vector3d(1, 1, 1), Eigen::Vector3d::Zero(), 1)), 200);  // dup
+    w.write("TARGET_STATE", to_lcm(target_at(400, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 1)), 400);
+    w.raw("TARGET_STATE", {1, 2, 3, 4}, 410);  // corrupt
+  }
+  LogEvalOptions o;
+  o.target_channel = "TARGET_STATE";
+  const LogEvalResult r = evaluate_log(path, o);
+  CHECK(r.malformed_targets == 1);
+  CHECK(r.target_counts.states == 4);
+  CHECK(r.target_counts.duplicate_states == 1);
+  CHECK(r.target_counts.matched == 2);
+  CHECK(r.target_counts.unmatched == 1);
+  REQUIRE(r.target_in_imu.count == 2);
+  REQUIRE(r.target_in_world.count == 2);
+  // RMSE_p = √((0.03² + 0.04²)/2) = 0.025·√2; RMSE_θ = 0.02 rad; in both frames.
+  CHECK_THAT(r.target_in_imu.rmse_position_m, WithinRel(0.025 * std::sqrt(2.0), 1e-9));
+  CHECK_THAT(r.target_in_world.rmse_position_m, WithinRel(0.025 * std::sqrt(2.0), 1e-9));
+  CHECK_THAT(r.target_in_imu.rmse_orientation_deg, WithinRel(0.02 * 180.0 / M_PI, 1e-9));
+  CHECK_THAT(r.target_in_world.rmse_orientation_deg, WithinRel(0.02 * 180.0 / M_PI, 1e-9));
+  // NEES_p: 9 and 4; NEES_θ: 4 and 1 — in I only; the world frame has no covariance.
+  CHECK_THAT(r.target_in_imu.nees_position, WithinRel(6.5, 1e-9));
+  CHECK_THAT(r.target_in_imu.nees_orientation, WithinRel(2.5, 1e-9));
+  CHECK(std::isnan(r.target_in_world.nees_position));
+  // Without --target-channel nothing of it is evaluated.
+  CHECK(evaluate_log(path).target_in_imu.count == 0);
+  std::remove(path.c_str());
+}
+
 TEST_CASE("An offline run through LCM messages evaluates identically", "[eval][log]") {
   const std::string src = VIMOT_SOURCE_DIR;
   sim::SimConfig cfg = sim::from_config(Config::load_file(src + "/config/sim_paper.yaml"));
