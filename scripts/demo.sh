@@ -14,8 +14,11 @@
 #   VIMOT_SEED        noise seed (default 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
-#   LCM_DEFAULT_URL   LCM network (default udpm://239.255.76.67:7667?ttl=0,
-#                     which never leaves this machine)
+#   LCM_DEFAULT_URL   LCM network (default
+#                     udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304: never
+#                     leaves this machine; 4 MiB receive buffers (capped by the
+#                     kernel's net.core.rmem_max) so a process that stalls for a
+#                     moment under load does not lose UDP packets)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${VIMOT_BUILD_DIR:-$here/build}"
@@ -32,7 +35,7 @@ export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
 export VIMOT_SPEED="${VIMOT_SPEED:-4}"
 export VIMOT_SEED="${VIMOT_SEED:-1}"
 export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins.yaml}"
-export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}"
+export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304}"
 out="${VIMOT_OUT:-$here/out/demo-$(date +%Y%m%d-%H%M%S)}"
 mkdir -p "$out"
 export VIMOT_LOG="$out/demo.lcmlog"
