@@ -84,6 +84,11 @@ void ScaleNode::on_nav_state(const NavState& state) {
     process_pair(state, pose);
     return;
   }
+  if (last_object_utime_ && *last_object_utime_ > state.utime) {
+    ++stats_.stale_states;  // the tracker is past this frame: it skipped it
+    say(VinsEvent::Kind::kDropped, "VINS state at utime " + std::to_string(state.utime) + " never matched");
+    return;
+  }
   states_.push_back(state);
   if (static_cast<int>(states_.size()) > options_.max_pending) {
     drop_older(&states_, states_[1].utime, &stats_.stale_states, "VINS state (queue full)");
@@ -110,6 +115,11 @@ void ScaleNode::on_object_pose(const ObjectPoseUpToScale& pose) {
     const NavState state = states_.front();
     states_.pop_front();
     process_pair(state, pose);
+    return;
+  }
+  if (last_state_utime_ && *last_state_utime_ > pose.utime) {
+    ++stats_.stale_object_poses;  // VINS is past this frame: it skipped it
+    say(VinsEvent::Kind::kDropped, "object pose at utime " + std::to_string(pose.utime) + " never matched");
     return;
   }
   object_poses_.push_back(pose);

@@ -127,7 +127,7 @@ TEST_CASE("scale_node: a side that lags is buffered; passed or overflowing messa
   Outputs out;
   ScaleNode node = make_node(&out, /*max_pending=*/3);
   const CameraCalibration cam = test_camera();
-  const std::vector<ScaleObservation> obs = generate(normal_camera, normal_object, kScale, 12);
+  const std::vector<ScaleObservation> obs = generate(normal_camera, normal_object, kScale, 13);
   // VINS lags by 3 frames: the object poses wait, then all pair.
   for (int k = 0; k < 3; ++k) node.on_object_pose(pose_of(obs[k]));
   CHECK(node.pending_object_poses() == 3);
@@ -142,27 +142,35 @@ TEST_CASE("scale_node: a side that lags is buffered; passed or overflowing messa
   CHECK(node.pending_object_poses() == 1);
   node.on_nav_state(state_of(obs[4], cam));
   CHECK(node.stats().pairs == 4);
+  // Frame 5's object pose comes after VINS passed it (VINS skipped frame 5): stale at once.
+  node.on_nav_state(state_of(obs[6], cam));
+  node.on_object_pose(pose_of(obs[5]));
+  CHECK(node.stats().stale_object_poses == 1);
+  CHECK(node.pending_object_poses() == 0);
+  CHECK(node.pending_states() == 1);
+  node.on_object_pose(pose_of(obs[6]));
+  CHECK(node.stats().pairs == 5);
   // VINS silent: beyond max_pending the oldest object poses are dropped.
-  for (int k = 5; k < 10; ++k) node.on_object_pose(pose_of(obs[k]));
+  for (int k = 7; k < 12; ++k) node.on_object_pose(pose_of(obs[k]));
   CHECK(node.pending_object_poses() == 3);
-  CHECK(node.stats().stale_object_poses == 2);
-  for (int k = 7; k < 10; ++k) node.on_nav_state(state_of(obs[k], cam));
-  CHECK(node.stats().pairs == 7);
+  CHECK(node.stats().stale_object_poses == 1 + 2);
+  for (int k = 9; k < 12; ++k) node.on_nav_state(state_of(obs[k], cam));
+  CHECK(node.stats().pairs == 8);
   // Duplicates and time going backwards, per channel.
-  node.on_nav_state(state_of(obs[9], cam));
-  node.on_object_pose(pose_of(obs[8]));
+  node.on_nav_state(state_of(obs[11], cam));
+  node.on_object_pose(pose_of(obs[10]));
   CHECK(node.stats().duplicate_or_backwards == 2);
-  CHECK(node.stats().pairs == 7);
+  CHECK(node.stats().pairs == 8);
   // A NaN in a pair is refused by the core, counted, and changes nothing.
-  ObjectPoseUpToScale bad = pose_of(obs[10]);
+  ObjectPoseUpToScale bad = pose_of(obs[12]);
   bad.pbar_OinC.y() = std::numeric_limits<double>::quiet_NaN();
   node.on_object_pose(bad);
-  node.on_nav_state(state_of(obs[10], cam));
+  node.on_nav_state(state_of(obs[12], cam));
   CHECK(node.stats().rejected_observations == 1);
-  CHECK(node.estimator().window().size() == 7);
+  CHECK(node.estimator().window().size() == 8);
   int dropped = 0;
   for (const VinsEvent& e : out.events) dropped += e.kind == VinsEvent::Kind::kDropped;
-  CHECK(dropped == 1 + 2 + 2 + 1);
+  CHECK(dropped == 1 + 3 + 2 + 1);
 }
 
 TEST_CASE("scale_node: held scale for the metric pose; tracking loss resets", "[scale]") {
