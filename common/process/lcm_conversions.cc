@@ -255,4 +255,43 @@ TargetPosePrediction from_lcm(const target_prediction_t& msg) {
   return p;
 }
 
+// --- scale estimator (issue 5)
+
+ObjectPoseUpToScale from_lcm(const object_pose_t& msg) {
+  ObjectPoseUpToScale p;
+  p.utime = msg.utime;
+  p.valid = msg.valid;
+  p.num_features = msg.num_features;
+  p.reprojection_rms = msg.reprojection_rms;
+  if (p.valid) {  // an invalid pose's fields are meaningless (may be NaN)
+    p.q_OtoC = read<4>(msg.q_OtoC, "object_pose_t.q_OtoC", msg.utime);
+    p.pbar_OinC = read<3>(msg.p_OinC, "object_pose_t.p_OinC", msg.utime);
+  }
+  return p;
+}
+
+scale_estimate_t to_lcm(const scale::ScaleResult& r) {
+  scale_estimate_t msg{};
+  msg.utime = r.utime;
+  msg.scale = r.scale;
+  msg.accepted = r.accepted;
+  msg.f_value = r.f_value;
+  for (int k = 0; k < 3; ++k) {
+    msg.condition[k] = r.condition[k];
+    msg.condition_ok[k] = r.condition_ok[k];
+  }
+  msg.failed_condition = static_cast<int8_t>(r.failed_condition);
+  msg.num_observations = r.num_observations;
+  return msg;
+}
+
+metric_object_pose_t to_lcm(const scale::ObjectPoseInWorld& pose) {
+  metric_object_pose_t msg{};
+  msg.utime = pose.utime;
+  msg.scale = pose.scale;
+  write<4>(pose.q_GtoO, msg.q_GtoO);
+  write<3>(pose.p_OinG, msg.p_OinG);
+  return msg;
+}
+
 }  // namespace vimot

@@ -14,6 +14,12 @@
 #include "vimot/nav_state_t.hpp"
 #include "vimot/target_prediction_t.hpp"
 #include "vimot/target_state_t.hpp"
+// scale estimator
+#include "common/types/object_pose.h"
+#include "procs/scale_estimator/scale_estimator.h"
+#include "vimot/metric_object_pose_t.hpp"
+#include "vimot/object_pose_t.hpp"
+#include "vimot/scale_estimate_t.hpp"
 
 namespace vimot {
 
@@ -34,5 +40,14 @@ TargetStateEstimate from_lcm(const target_state_t& msg);
 
 target_prediction_t to_lcm(const TargetPosePrediction& prediction);
 TargetPosePrediction from_lcm(const target_prediction_t& msg);
+
+// --- scale estimator (issue 5): OBJECT_POSE_UPTOSCALE in, SCALE_ESTIMATE and
+// OBJECT_POSE_METRIC out.
+
+/// The pose fields are read (and checked finite) only when msg.valid.
+ObjectPoseUpToScale from_lcm(const object_pose_t& msg);
+
+scale_estimate_t to_lcm(const scale::ScaleResult& result);
+metric_object_pose_t to_lcm(const scale::ObjectPoseInWorld& pose);
 
 }  // namespace vimot

@@ -128,13 +128,17 @@ ScenarioMotion make_mono(const SimConfig& config) {
   const double span = std::max(duration, mc.duration);
   const double h_T = target_center_height(config.target);
 
-  auto object_pose = [&mc, h_T](double t) {
+  auto heading_along_velocity = [&mc](double t) {
     const Eigen::Array2d w = kTwoPi * mc.object_frequency_hz.array();
-    const Eigen::Array2d arg = w * t + mc.object_phase.array();
-    const Eigen::Vector2d p = mc.object_center.array() + mc.object_amplitude.array() * arg.sin();
-    const Eigen::Vector2d v = mc.object_amplitude.array() * w * arg.cos();
+    const Eigen::Vector2d v = mc.object_amplitude.array() * w * (w * t + mc.object_phase.array()).cos();
     // A motionless object (zero amplitudes) keeps yaw 0.
-    const double yaw = v.norm() > 1e-12 ? std::atan2(v.y(), v.x()) : 0.0;
+    return v.norm() > 1e-12 ? std::atan2(v.y(), v.x()) : 0.0;
+  };
+  const double yaw0 = heading_along_velocity(0.0);
+  auto object_pose = [&mc, h_T, &heading_along_velocity, yaw0](double t) {
+    const Eigen::Array2d arg = kTwoPi * mc.object_frequency_hz.array() * t + mc.object_phase.array();
+    const Eigen::Vector2d p = mc.object_center.array() + mc.object_amplitude.array() * arg.sin();
+    const double yaw = mc.object_heading == ObjectHeading::kFixed ? yaw0 : heading_along_velocity(t);
     return make_se3(rot_z(yaw), Eigen::Vector3d(p.x(), p.y(), h_T));
   };
   // Camera position relative to its anchor (G axes, or T axes for kObjectPose).

@@ -236,6 +236,12 @@ CameraPointing camera_pointing_from_string(const std::string& name) {
   throw std::invalid_argument("unknown camera pointing '" + name + "' (expected look_at_object or fixed)");
 }
 
+ObjectHeading object_heading_from_string(const std::string& name) {
+  if (name == "along_velocity") return ObjectHeading::kAlongVelocity;
+  if (name == "fixed") return ObjectHeading::kFixed;
+  throw std::invalid_argument("unknown object heading '" + name + "' (expected along_velocity or fixed)");
+}
+
 void validate(const SimConfig& config) {
   const std::string p = problem(config);
   if (!p.empty()) throw std::invalid_argument("SimConfig: " + p);
@@ -352,13 +358,20 @@ SimConfig from_config(const Config& config) {
   r.read("trajectory.start_distance", &c.trajectory.start_distance);
 
   r.only_keys("mono", {"duration", "object_center", "object_amplitude", "object_frequency_hz", "object_phase",
-                       "camera_anchor", "camera_pointing", "camera_base", "camera_velocity", "camera_translation",
-                       "camera_wobble", "room_min", "room_max", "spline_dt"});
+                       "object_heading", "camera_anchor", "camera_pointing", "camera_base", "camera_velocity",
+                       "camera_translation", "camera_wobble", "room_min", "room_max", "spline_dt"});
   r.read("mono.duration", &c.mono.duration);
   r.read_vec2("mono.object_center", &c.mono.object_center);
   r.read_vec2("mono.object_amplitude", &c.mono.object_amplitude);
   r.read_vec2("mono.object_frequency_hz", &c.mono.object_frequency_hz);
   r.read_vec2("mono.object_phase", &c.mono.object_phase);
+  try {
+    if (config.has("mono.object_heading")) {
+      c.mono.object_heading = object_heading_from_string(config.get<std::string>("mono.object_heading"));
+    }
+  } catch (const std::invalid_argument& e) {
+    r.fail("mono.object_heading", std::string("is invalid: ") + e.what());
+  }
   try {
     if (config.has("mono.camera_anchor")) {
       c.mono.anchor = camera_anchor_from_string(config.get<std::string>("mono.camera_anchor"));

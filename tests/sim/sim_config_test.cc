@@ -51,9 +51,10 @@ TEST_CASE("config/sim_mono.yaml: one camera, a box, the free camera motion") {
   CHECK(c.camera.calibrations.size() == 1);
   CHECK(c.target.size == Eigen::Vector3d(0.4, 0.3, 0.3));
   CHECK(c.mono.camera_translation.size() == 2);
-  CHECK(c.mono.camera_translation[1].frequency_hz == Eigen::Vector3d(0.43, 0.31, 0.53));
+  CHECK(c.mono.camera_translation[1].frequency_hz == Eigen::Vector3d(1.31, 1.07, 1.73));
   CHECK(c.mono.anchor == CameraAnchor::kWorld);
   CHECK(c.mono.pointing == CameraPointing::kLookAtObject);
+  CHECK(c.mono.object_heading == ObjectHeading::kAlongVelocity);
 }
 
 TEST_CASE("config/sim_trajectory.yaml: 400 Hz, 250 features per camera at 5-7 m, path from VIMOT_DATA_DIR") {
@@ -107,6 +108,8 @@ TEST_CASE("Invalid or unknown keys are refused naming the file, the key and the 
   CHECK_THAT(e, Catch::Contains("cameras.cam0"));
   e = error_of(std::string(kMinimal) + "mono: {camera_anchor: ceiling}\n");
   CHECK_THAT(e, Catch::Contains("mono.camera_anchor") && Catch::Contains("ceiling"));
+  e = error_of(std::string(kMinimal) + "mono: {object_heading: north}\n");
+  CHECK_THAT(e, Catch::Contains("mono.object_heading") && Catch::Contains("north"));
 }
 
 TEST_CASE("validate() and the Simulator refuse a bad SimConfig naming the field and value") {

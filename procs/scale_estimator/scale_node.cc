@@ -1,0 +1,167 @@
+#include "procs/scale_estimator/scale_node.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "common/config/config.h"
+#include "common/math/quat.h"
+
+namespace vimot {
+
+CameraPoseInWorld camera_pose_in_world(const Eigen::Vector4d& q_GtoI, const Eigen::Vector3d& p_IinG,
+                                       const CameraCalibration& camera) {
+  const Eigen::Matrix3d R_ItoG = quat_to_rot(q_GtoI).transpose();
+  CameraPoseInWorld pose;
+  pose.R_CtoG = R_ItoG * camera.R_ItoC.transpose();
+  pose.p_CinG = p_IinG - R_ItoG * camera.R_ItoC.transpose() * camera.p_IinC;
+  return pose;
+}
+
+void ScaleNodeOptions::validate() const {
+  estimator.validate();
+  if (max_pending < 1) throw std::invalid_argument("max_pending must be >= 1, got " + std::to_string(max_pending));
+  if (!(estimate_period_s >= 0.0)) {
+    throw std::invalid_argument("estimate_period_s must be >= 0, got " + std::to_string(estimate_period_s));
+  }
+}
+
+ScaleNodeOptions scale_node_options_from_config(const Config& cfg) {
+  ScaleNodeOptions o;
+  o.estimator = scale::ScaleEstimatorOptions::from_config(cfg, "scale_estimator");
+  const Config calib = Config::load_file(cfg.resolve_path(cfg.get<std::string>("calibration_file")));
+  o.camera = camera_from_config(calib.sub("cameras.cam0"));
+  o.max_pending = cfg.get_or<int>("node.max_pending", o.max_pending);
+  o.estimate_period_s = cfg.get_or<double>("node.estimate_period_s", o.estimate_period_s);
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    cfg.fail("node", e.what());
+  }
+  return o;
+}
+
+ScaleNode::ScaleNode(const ScaleNodeOptions& options, ScaleCallback on_scale, PoseCallback on_pose,
+                     EventCallback on_event)
+    : options_((options.validate(), options)),
+      estimator_(options.estimator),
+      on_scale_(std::move(on_scale)),
+      on_pose_(std::move(on_pose)),
+      on_event_(std::move(on_event)) {}
+
+void ScaleNode::say(VinsEvent::Kind kind, const std::string& message) {
+  if (on_event_) on_event_(VinsEvent{kind, message});
+}
+
+bool ScaleNode::in_order(int64_t utime, std::optional<int64_t>* last, const char* channel) {
+  if (*last && utime <= **last) {
+    ++stats_.duplicate_or_backwards;
+    say(VinsEvent::Kind::kDropped, std::string(channel) + (utime == **last ? " duplicate" : " went back in time") +
+                                       " at utime " + std::to_string(utime));
+    return false;
+  }
+  *last = utime;
+  return true;
+}
+
+template <typename T>
+void ScaleNode::drop_older(std::deque<T>* queue, int64_t utime, int64_t* counter, const char* what) {
+  while (!queue->empty() && queue->front().utime < utime) {
+    ++*counter;
+    say(VinsEvent::Kind::kDropped, std::string(what) + " at utime " + std::to_string(queue->front().utime) +
+                                       " never matched");
+    queue->pop_front();
+  }
+}
+
+void ScaleNode::on_nav_state(const NavState& state) {
+  if (!state.updated) return;
+  ++stats_.states_in;
+  if (!in_order(state.utime, &last_state_utime_, "VINS state")) return;
+  drop_older(&object_poses_, state.utime, &stats_.stale_object_poses, "object pose");
+  if (!object_poses_.empty() && object_poses_.front().utime == state.utime) {
+    const ObjectPoseUpToScale pose = object_poses_.front();
+    object_poses_.pop_front();
+    process_pair(state, pose);
+    return;
+  }
+  if (last_object_utime_ && *last_object_utime_ > state.utime) {
+    ++stats_.stale_states;  // the tracker is past this frame: it skipped it
+    say(VinsEvent::Kind::kDropped, "VINS state at utime " + std::to_string(state.utime) + " never matched");
+    return;
+  }
+  states_.push_back(state);
+  if (static_cast<int>(states_.size()) > options_.max_pending) {
+    drop_older(&states_, states_[1].utime, &stats_.stale_states, "VINS state (queue full)");
+  }
+}
+
+void ScaleNode::on_object_pose(const ObjectPoseUpToScale& pose) {
+  ++stats_.object_poses_in;
+  if (!in_order(pose.utime, &last_object_utime_, "object pose")) return;
+  drop_older(&states_, pose.utime, &stats_.stale_states, "VINS state");
+  const bool state_waiting = !states_.empty() && states_.front().utime == pose.utime;
+  if (!pose.valid) {
+    ++stats_.invalid_object_poses;
+    if (state_waiting) states_.pop_front();
+    if (estimator_.has_scale() || !estimator_.window().empty()) {
+      say(VinsEvent::Kind::kInfo, "object tracking lost at utime " + std::to_string(pose.utime) +
+                                      ": scale estimator reset");
+    }
+    estimator_.reset();
+    last_estimate_utime_.reset();
+    return;
+  }
+  if (state_waiting) {
+    const NavState state = states_.front();
+    states_.pop_front();
+    process_pair(state, pose);
+    return;
+  }
+  if (last_state_utime_ && *last_state_utime_ > pose.utime) {
+    ++stats_.stale_object_poses;  // VINS is past this frame: it skipped it
+    say(VinsEvent::Kind::kDropped, "object pose at utime " + std::to_string(pose.utime) + " never matched");
+    return;
+  }
+  object_poses_.push_back(pose);
+  if (static_cast<int>(object_poses_.size()) > options_.max_pending) {
+    drop_older(&object_poses_, object_poses_[1].utime, &stats_.stale_object_poses, "object pose (queue full)");
+  }
+}
+
+void ScaleNode::process_pair(const NavState& state, const ObjectPoseUpToScale& pose) {
+  ++stats_.pairs;
+  const CameraPoseInWorld camera = camera_pose_in_world(state.q_GtoI, state.p_IinG, options_.camera);
+  scale::ScaleObservation obs;
+  obs.utime = state.utime;
+  obs.q_GtoC = rot_to_quat(camera.R_CtoG.transpose());
+  obs.p_CinG = camera.p_CinG;
+  obs.q_OtoC = pose.q_OtoC;
+  obs.pbar_OinC = pose.pbar_OinC;
+
+  const scale::AddStatus status = estimator_.add(obs);
+  if (!scale::is_added(status)) {
+    ++stats_.rejected_observations;
+    say(VinsEvent::Kind::kDropped, std::string("pair at utime ") + std::to_string(obs.utime) +
+                                       " rejected: " + scale::to_string(status));
+    return;
+  }
+  if (status == scale::AddStatus::kAddedAfterGap) {
+    say(VinsEvent::Kind::kInfo, "gap before utime " + std::to_string(obs.utime) + ": window cleared");
+    last_estimate_utime_.reset();
+  }
+
+  const bool due = !last_estimate_utime_ ||
+                   static_cast<double>(obs.utime - *last_estimate_utime_) * 1e-6 >= options_.estimate_period_s;
+  if (due && static_cast<int>(estimator_.window().size()) >= options_.estimator.min_observations) {
+    const scale::ScaleResult result = estimator_.update();
+    last_estimate_utime_ = obs.utime;
+    ++stats_.estimates;
+    if (on_scale_) on_scale_(result);
+  }
+  if (const auto metric = estimator_.latest_object_pose()) {
+    ++stats_.metric_poses;
+    if (on_pose_) on_pose_(*metric);
+  }
+}
+
+}  // namespace vimot

@@ -1,0 +1,124 @@
+#pragma once
+// The `scale_estimator` process's logic without LCM: pairs the VINS camera
+// pose and the tracker's up-to-scale object pose of the same camera frame,
+// feeds ScaleEstimator, and says what to publish. main.cc only moves
+// messages. Time is the messages' utime only (never the wall clock), so a
+// live run and a log replay give the same output.
+//
+// Pairing: an updated VINS_STATE (camera rate) and an OBJECT_POSE_UPTOSCALE
+// refer to the same camera frame iff their utimes are equal. Either may
+// arrive first; the unmatched ones wait in two bounded queues. Each channel
+// is in time order, so once one side has reached utime t, a waiting message
+// of the other side older than t can never be matched: it is dropped as
+// stale (counted). Per channel, a utime equal to the previous one is a
+// duplicate and one before it goes backwards: both dropped and counted.
+//
+// Tracking loss: object_pose_t carries no track id, so after an invalid
+// pose the next valid one may come from a re-initialised track whose length
+// unit (the initial depth, scale paper Fig. 5) differs. An invalid pose
+// therefore resets the estimator: window and held scale. Within a track the
+// last accepted scale is held until a new one is accepted.
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "common/camera/camera_model.h"
+#include "common/types/nav_state.h"
+#include "common/types/object_pose.h"
+#include "procs/scale_estimator/scale_estimator.h"
+#include "procs/vins/vins_node.h"
+
+namespace vimot {
+
+/// Camera pose in G from the IMU pose and the camera's extrinsics
+/// (p_C = R_ItoC p_I + p_IinC):
+///   R_CtoG = R_GtoI^T R_ItoC^T
+///   p_CinG = p_IinG + R_GtoI^T p_CinI,   p_CinI = -R_ItoC^T p_IinC
+struct CameraPoseInWorld {
+  Eigen::Matrix3d R_CtoG{Eigen::Matrix3d::Identity()};
+  Eigen::Vector3d p_CinG{Eigen::Vector3d::Zero()};
+};
+CameraPoseInWorld camera_pose_in_world(const Eigen::Vector4d& q_GtoI, const Eigen::Vector3d& p_IinG,
+                                       const CameraCalibration& camera);
+
+struct ScaleNodeOptions {
+  scale::ScaleEstimatorOptions estimator;
+  /// The monocular camera (cam0); only its extrinsics R_ItoC, p_IinC are used.
+  CameraCalibration camera;
+  /// Unmatched messages kept per side (20 Hz camera: 10 = 0.5 s of latency).
+  int max_pending{10};
+  /// Estimate (and publish SCALE_ESTIMATE) at most every this many seconds
+  /// of message time; 0 = for every pair.
+  double estimate_period_s{0.0};
+
+  /// Throws std::invalid_argument naming the bad option.
+  void validate() const;
+};
+
+/// From a config/scale_estimator.yaml: `scale_estimator:` (the core's
+/// options), `node:` (max_pending, estimate_period_s) and cam0 of
+/// `calibration_file` (ASL layout, relative to the config's directory).
+/// Throws ConfigError naming the file and key.
+ScaleNodeOptions scale_node_options_from_config(const Config& cfg);
+
+struct ScaleNodeStats {
+  int64_t states_in{0};            // updated VINS states received
+  int64_t object_poses_in{0};
+  int64_t pairs{0};                // matched by utime
+  int64_t stale_states{0};         // dropped unmatched (other side passed them, or queue full)
+  int64_t stale_object_poses{0};
+  int64_t duplicate_or_backwards{0};
+  int64_t invalid_object_poses{0};  // tracking lost: each one resets the estimator
+  int64_t rejected_observations{0};  // pairs the core refused (non-finite, bad quaternion, time order)
+  int64_t estimates{0};            // SCALE_ESTIMATE published
+  int64_t metric_poses{0};         // OBJECT_POSE_METRIC published
+};
+
+class ScaleNode {
+ public:
+  using ScaleCallback = std::function<void(const scale::ScaleResult&)>;
+  using PoseCallback = std::function<void(const scale::ObjectPoseInWorld&)>;
+  /// The event kinds of the estimator processes (info, dropped, error).
+  using EventCallback = std::function<void(const VinsEvent&)>;
+
+  /// Throws std::invalid_argument on invalid options.
+  ScaleNode(const ScaleNodeOptions& options, ScaleCallback on_scale, PoseCallback on_pose,
+            EventCallback on_event);
+
+  /// Only camera-rate states (updated = true) are used; IMU-rate ones are ignored.
+  void on_nav_state(const NavState& state);
+  void on_object_pose(const ObjectPoseUpToScale& pose);
+
+  const ScaleNodeStats& stats() const { return stats_; }
+  const scale::ScaleEstimator& estimator() const { return estimator_; }
+  std::size_t pending_states() const { return states_.size(); }
+  std::size_t pending_object_poses() const { return object_poses_.size(); }
+
+ private:
+  /// False (and counted) if `utime` repeats or precedes `last` of its channel.
+  bool in_order(int64_t utime, std::optional<int64_t>* last, const char* channel);
+  /// Drops queued messages older than `utime` (the other side passed them).
+  template <typename T>
+  void drop_older(std::deque<T>* queue, int64_t utime, int64_t* counter, const char* what);
+  void process_pair(const NavState& state, const ObjectPoseUpToScale& pose);
+  void say(VinsEvent::Kind kind, const std::string& message);
+
+  ScaleNodeOptions options_;
+  scale::ScaleEstimator estimator_;
+  ScaleCallback on_scale_;
+  PoseCallback on_pose_;
+  EventCallback on_event_;
+  std::deque<NavState> states_;
+  std::deque<ObjectPoseUpToScale> object_poses_;
+  std::optional<int64_t> last_state_utime_;
+  std::optional<int64_t> last_object_utime_;
+  std::optional<int64_t> last_estimate_utime_;
+  ScaleNodeStats stats_;
+};
+
+}  // namespace vimot

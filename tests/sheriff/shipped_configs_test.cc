@@ -1,0 +1,45 @@
+// The shipped sheriff configs (sheriff_configs/*.pmd) load without warnings,
+// start the processes their scenario needs and name config files that exist.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "procs/sheriff/sheriff_config_parser.h"
+
+using namespace vimot::sheriff;
+
+namespace {
+
+std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
+
+void check_config(const std::string& pmd, const std::vector<std::string>& expected_commands,
+                  const std::vector<std::string>& config_files) {
+  INFO(pmd);
+  const SheriffConfig config = LoadSheriffConfig(source_path("sheriff_configs/" + pmd));
+  CHECK(config.warnings().empty());
+  std::vector<std::string> names;
+  std::string execs;
+  for (const CommandSpec& c : config.commands()) {
+    names.push_back(c.name);
+    execs += c.exec + " \n";  // each argument ends with a space
+  }
+  CHECK(names == expected_commands);
+  for (const std::string& file : config_files) {
+    INFO(file);
+    CHECK(execs.find("${VIMOT_CONFIG}/" + file + " ") != std::string::npos);
+    CHECK(std::ifstream(source_path("config/" + file)).good());
+  }
+  REQUIRE(config.scripts().size() == 1);
+  CHECK(config.scripts()[0].name == "run");
+}
+
+}  // namespace
+
+TEST_CASE("shipped sheriff configs parse") {
+  check_config("sim_demo.pmd", {"logger", "vins", "target_filter", "sim"}, {"target_filter.yaml"});
+  // config/object_tracker.yaml comes with the object tracker (issue 5, tracker branch).
+  check_config("sim_mono.pmd", {"logger", "vins", "object_tracker", "scale_estimator", "sim"},
+               {"vins_mono.yaml", "scale_estimator.yaml"});
+}
