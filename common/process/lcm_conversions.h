@@ -6,12 +6,14 @@
 
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
+#include "common/types/object_pose.h"
 #include "common/types/sensor_data.h"
 #include "common/types/target_state.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
 #include "vimot/imu_t.hpp"
 #include "vimot/nav_state_t.hpp"
+#include "vimot/object_pose_t.hpp"
 #include "vimot/target_prediction_t.hpp"
 #include "vimot/target_state_t.hpp"
 
@@ -34,5 +36,10 @@ TargetStateEstimate from_lcm(const target_state_t& msg);
 
 target_prediction_t to_lcm(const TargetPosePrediction& prediction);
 TargetPosePrediction from_lcm(const target_prediction_t& msg);
+
+// Object tracker (issue 5). object_pose_t has no track id: from_lcm() gives
+// track_id 0; a consumer sees a new track as valid false -> true.
+object_pose_t to_lcm(const ObjectPoseEstimate& estimate);
+ObjectPoseEstimate from_lcm(const object_pose_t& msg);
 
 }  // namespace vimot
