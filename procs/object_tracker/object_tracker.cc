@@ -19,6 +19,9 @@ namespace vimot {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
+// The initialisation starts from a two-view guess, far from the optimum
+// compared with a tracked frame's PnP pose: it gets more iterations.
+constexpr int kInitIterationFactor = 5;
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -105,6 +108,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.min_init_features = config.get_or<int>(s + "min_init_features", o.min_init_features);
   o.min_init_parallax_deg = config.get_or<double>(s + "min_init_parallax_deg", o.min_init_parallax_deg);
   o.init_frames = config.get_or<int>(s + "init_frames", o.init_frames);
+  o.init_min_displacement_px = config.get_or<double>(s + "init_min_displacement_px", o.init_min_displacement_px);
   o.ransac_threshold_px = config.get_or<double>(s + "ransac_threshold_px", o.ransac_threshold_px);
   o.reference_features = config.get_or<int>(s + "reference_features", o.reference_features);
   o.min_track_features = config.get_or<int>(s + "min_track_features", o.min_track_features);
@@ -113,6 +117,8 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.min_feature_parallax_deg = config.get_or<double>(s + "min_feature_parallax_deg", o.min_feature_parallax_deg);
   o.min_feature_observations = config.get_or<int>(s + "min_feature_observations", o.min_feature_observations);
   o.max_iterations = config.get_or<int>(s + "max_iterations", o.max_iterations);
+  o.keyframe_rotation_deg = config.get_or<double>(s + "keyframe_rotation_deg", o.keyframe_rotation_deg);
+  o.keyframe_baseline = config.get_or<double>(s + "keyframe_baseline", o.keyframe_baseline);
   if (o.window_size < 3) throw std::invalid_argument(s + "window_size must be >= 3");
   if (!(o.focal_length_px > 0.0)) throw std::invalid_argument(s + "focal_length_px must be > 0");
   if (o.robust_loss != "huber" && o.robust_loss != "cauchy") {
@@ -178,6 +184,19 @@ ObjectPoseEstimate ObjectTracker::process(const CameraFrame& frame, const std::o
 ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   ObjectPoseEstimate invalid;
   invalid.utime = frame.utime;
+  // Frames join the buffer once the image has moved: the buffer then spans
+  // enough relative motion to tell rotation from translation (see below).
+  if (!init_frames_.empty()) {
+    std::vector<double> displacement;
+    for (const auto& [id, z] : frame.observations) {
+      const auto last = init_frames_.back().observations.find(id);
+      if (last != init_frames_.back().observations.end()) displacement.push_back((z - last->second).norm());
+    }
+    if (static_cast<int>(displacement.size()) >= options_.min_init_features &&
+        median(displacement) * options_.focal_length_px < options_.init_min_displacement_px) {
+      return invalid;
+    }
+  }
   init_frames_.push_back(std::move(frame));
   // The reference must share enough features with the current frame and
   // stay within one window of it; otherwise the next frame becomes it.
@@ -204,6 +223,7 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   }
   const double threshold = options_.ransac_threshold_px / options_.focal_length_px;
   cv::Mat inlier_mask;
+  cv::theRNG().state = 1;  // RANSAC samples: the same input gives the same track
   const cv::Mat E = cv::findEssentialMat(p0, p1, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, threshold, inlier_mask);
   if (E.rows != 3 || E.cols != 3) return invalid;
   cv::Mat R_cv, t_cv;
@@ -238,7 +258,9 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   // A BA over all buffered frames from these depths, the frames after the
   // reference posed by PnP in turn: a small object spans a narrow field of
   // view, where two views hardly separate rotation from translation.
-  // Returns the first solve's cost; the state is left in the members.
+  // Returns the cost per observation after the outlier removal (the two
+  // hypotheses may keep different observations); the state is left in the
+  // members.
   const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<double> {
     poses_.clear();
     features_.clear();
@@ -262,10 +284,9 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     }
     // Only the reference pose is fixed; the scale freedom is removed by
     // the normalisation below.
-    if (!solve_window(1)) return std::nullopt;
-    const double cost = last_cost_;
-    if (remove_outliers() > 0 && !solve_window(1)) return std::nullopt;
-    return cost;
+    if (!solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
+    if (remove_outliers() > 0 && !solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
+    return last_cost_ / std::max(last_num_residuals_, 1);
   };
   // Under the near-affine projection of a small object the depth-reversed
   // structure (Necker reversal: depths mirrored about their median) fits
@@ -285,7 +306,6 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   }
   const std::optional<double> reversed_cost =
       static_cast<int>(reversed.size()) >= options_.min_init_features ? solve_from(reversed) : std::nullopt;
-  if (std::getenv("DBG")) fprintf(stderr, "INIT cost %g reversed %g\n", cost ? *cost : -1.0, reversed_cost ? *reversed_cost : -1.0);
   if (!reversed_cost || (cost && *cost <= *reversed_cost)) {
     if (!cost) return invalid;
     poses_ = kept_poses;
@@ -348,8 +368,13 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
 
   const auto t0 = std::chrono::steady_clock::now();
   add_observations(utime, obs, predict_pose(obs));
-  const bool solved = solve_window(2);
-  if (solved && remove_outliers() > 0) solve_window(2);
+  bool solved = solve_window(2, options_.max_iterations);
+  // The second removal catches what the re-solve pushed out (e.g. a new
+  // point behind a camera); it changes no estimate, so no third solve.
+  if (solved && remove_outliers() > 0) {
+    solved = solve_window(2, options_.max_iterations);
+    remove_outliers();
+  }
   last_solve_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!solved) return lose_track();
 
@@ -375,12 +400,11 @@ ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
   cv::eigen2cv(Eigen::Matrix3d(last.q_OtoC.toRotationMatrix()), R_last);
   cv::Rodrigues(R_last, rvec);
   cv::eigen2cv(last.pbar_OinC, tvec);
-  std::vector<int> inliers;
-  const bool ok = cv::solvePnPRansac(object_points, image_points, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
-                                     /*useExtrinsicGuess=*/true, 100,
-                                     static_cast<float>(options_.ransac_threshold_px / options_.focal_length_px),
-                                     0.99, inliers, cv::SOLVEPNP_ITERATIVE);
-  if (!ok || static_cast<int>(inliers.size()) < options_.min_track_features) return last;
+  // A local refinement from the last pose, not a RANSAC PnP: on a small
+  // object the minimal solutions jump between the near-ambiguous (depth
+  // reversed) poses, while 50 ms of motion stays in the right basin.
+  if (object_points.size() < 4) return last;
+  cv::solvePnPRefineLM(object_points, image_points, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec);
   cv::Mat R_cv;
   cv::Rodrigues(rvec, R_cv);
   Eigen::Matrix3d R_OtoC;
@@ -428,7 +452,7 @@ void ObjectTracker::add_observations(int64_t utime, const Observations& obs, con
   }
 }
 
-bool ObjectTracker::solve_window(int num_fixed_poses) {
+bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
   // Declared before the problem, which uses but does not own them.
   ceres::EigenQuaternionManifold quaternion_manifold;
   const double loss_scale = options_.robust_loss_px / options_.focal_length_px;
@@ -480,12 +504,13 @@ bool ObjectTracker::solve_window(int num_fixed_poses) {
 
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.max_num_iterations = options_.max_iterations;
+  solver_options.max_num_iterations = max_iterations;
   solver_options.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   if (!summary.IsSolutionUsable()) return false;
   last_cost_ = summary.final_cost;
+  last_num_residuals_ = problem.NumResidualBlocks();
   for (auto& [utime, pose] : poses_) {
     if (!pose.q_OtoC.coeffs().allFinite() || !pose.pbar_OinC.allFinite()) return false;
     pose.q_OtoC.normalize();
@@ -530,6 +555,9 @@ int ObjectTracker::remove_outliers() {
 
 void ObjectTracker::slide_window() {
   const int64_t current = window_.back();
+  if (window_.size() > static_cast<std::size_t>(options_.window_size) && !is_keyframe(window_.end()[-2], window_.end()[-3])) {
+    drop_frame(window_.end()[-2]);
+  }
   while (window_.size() > static_cast<std::size_t>(options_.window_size)) {
     const int64_t oldest = window_.front();
     window_.pop_front();
@@ -561,6 +589,41 @@ void ObjectTracker::slide_window() {
                                     [&](const auto& kv) { return kv.second.anchor_utime == utime; });
     it = needed ? std::next(it) : poses_.erase(it);
   }
+}
+
+bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
+  const Pose& a = poses_.at(previous_utime);
+  const Pose& b = poses_.at(utime);
+  const Eigen::Matrix3d R_a = a.q_OtoC.toRotationMatrix();
+  const Eigen::Matrix3d R_b = b.q_OtoC.toRotationMatrix();
+  const Eigen::Vector3d p_CainO = -R_a.transpose() * a.pbar_OinC;
+  const Eigen::Vector3d p_CbinO = -R_b.transpose() * b.pbar_OinC;
+  return rotation_angle_between(R_a, R_b) >= options_.keyframe_rotation_deg * kDegToRad ||
+         (p_CbinO - p_CainO).norm() >= options_.keyframe_baseline;
+}
+
+void ObjectTracker::drop_frame(int64_t utime) {
+  const int64_t current = window_.back();
+  for (auto it = features_.begin(); it != features_.end();) {
+    Feature& f = it->second;
+    if (f.anchor_utime == utime) {
+      // Re-anchored in the current frame, where the point keeps its place.
+      const auto z = f.observations.find(current);
+      const Pose& pose = poses_.at(current);
+      const double depth = z == f.observations.end() ? -1.0 : (pose.q_OtoC * point_in_O(f) + pose.pbar_OinC).z();
+      if (depth <= 0.0) {
+        it = features_.erase(it);
+        continue;
+      }
+      f.anchor_utime = current;
+      f.bearing = homogeneous(z->second);
+      f.inverse_depth = 1.0 / depth;
+    }
+    f.observations.erase(utime);
+    ++it;
+  }
+  window_.erase(std::find(window_.begin(), window_.end(), utime));
+  poses_.erase(utime);
 }
 
 void ObjectTracker::reset() {

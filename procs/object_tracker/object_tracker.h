@@ -50,14 +50,20 @@ struct ObjectTrackerOptions {
   int min_init_features{20};            // common target features needed to initialise
   double min_init_parallax_deg{2.0};    // median rotation-compensated parallax to initialise
   int init_frames{20};                  // frames the initialisation BA spans (reference to current)
+  double init_min_displacement_px{5.0}; // median image motion for a frame to join the initialisation
   double ransac_threshold_px{1.5};      // px, essential matrix and PnP RANSAC
   int reference_features{5};            // features nearest the centre ray that define depth 1
   int min_track_features{10};           // fewer BA features in a frame: track lost
   double max_reprojection_rms_px{3.0};  // larger RMS in a frame: track lost
   double outlier_threshold_px{3.0};     // observations beyond this are removed after the BA
-  double min_feature_parallax_deg{1.0}; // a new feature joins the BA with this parallax ...
+  double min_feature_parallax_deg{3.0}; // a new feature joins the BA with this parallax ...
   int min_feature_observations{3};      // ... and this many observations
   int max_iterations{10};               // Ceres iterations per frame
+  // The newest-but-one frame stays in the window (keyframe) if it moved this
+  // much from the frame before it, else it is dropped; so the window spans
+  // more relative motion than N consecutive frames.
+  double keyframe_rotation_deg{3.0};
+  double keyframe_baseline{0.05};       // tracker units (1 = the initial object distance)
 };
 
 /// Reads the `object_tracker:` section (every key optional, defaults above).
@@ -128,9 +134,11 @@ class ObjectTracker {
   ObjectPoseEstimate track(int64_t utime, const Observations& obs);
   Pose predict_pose(const Observations& obs) const;
   void add_observations(int64_t utime, const Observations& obs, const Pose& pose);
-  bool solve_window(int num_fixed_poses);
+  bool solve_window(int num_fixed_poses, int max_iterations);
   int remove_outliers();
   void slide_window();
+  bool is_keyframe(int64_t utime, int64_t previous_utime) const;
+  void drop_frame(int64_t utime);
   void reset();
   Eigen::Vector3d point_in_O(const Feature& f) const;
   double feature_parallax_rad(const Feature& f) const;
@@ -143,7 +151,8 @@ class ObjectTracker {
   int64_t next_track_id_{1};
   std::optional<InitFacts> init_facts_;
   double last_solve_seconds_{0.0};
-  double last_cost_{0.0};  // final cost of the last solve_window()
+  double last_cost_{0.0};      // final cost of the last solve_window()
+  int last_num_residuals_{0};  // its number of observations
 
   bool tracking_{false};
   // Initialisation buffer: frames since the reference frame.
