@@ -21,7 +21,15 @@
 //
 // Scale consistency: the two oldest window poses are held constant, and a
 // feature whose anchor frame has left the window is frozen (anchor pose and
-// inverse depth constant); those frozen points carry the gauge forward.
+// inverse depth constant); those frozen points carry the gauge forward. The
+// window keeps keyframes (the newest-but-one frame is dropped unless it
+// moved enough), so its N frames span more motion than N consecutive ones.
+//
+// Initialisation: frames join a buffer once the image moved; with
+// `init_frames` buffered, a two-view (essential matrix) between the first
+// and the last gives depths, the frames in between are posed by PnP and all
+// go through a BA. A small object projects almost affinely, so the
+// depth-reversed structure is solved too and the cheaper kept.
 //
 // Internally poses are Ceres parameter blocks (Eigen::Quaterniond, whose
 // coefficient order x y z w is what EigenQuaternionManifold expects); they
