@@ -255,20 +255,41 @@ TargetPosePrediction from_lcm(const target_prediction_t& msg) {
   return p;
 }
 
-// --- scale estimator (issue 5)
+// ---- object tracker (issue 5) ----------------------------------------------
 
-ObjectPoseUpToScale from_lcm(const object_pose_t& msg) {
-  ObjectPoseUpToScale p;
-  p.utime = msg.utime;
-  p.valid = msg.valid;
-  p.num_features = msg.num_features;
-  p.reprojection_rms = msg.reprojection_rms;
-  if (p.valid) {  // an invalid pose's fields are meaningless (may be NaN)
-    p.q_OtoC = read<4>(msg.q_OtoC, "object_pose_t.q_OtoC", msg.utime);
-    p.pbar_OinC = read<3>(msg.p_OinC, "object_pose_t.p_OinC", msg.utime);
-  }
-  return p;
+object_pose_t to_lcm(const ObjectPoseEstimate& e) {
+  object_pose_t msg{};
+  msg.utime = e.utime;
+  msg.valid = e.valid;
+  write<4>(e.q_OtoC, msg.q_OtoC);
+  write<3>(e.pbar_OinC, msg.p_OinC);
+  msg.num_features = e.num_features;
+  msg.reprojection_rms = e.reprojection_rms_px;
+  msg.track_id = e.track_id;
+  return msg;
 }
+
+ObjectPoseEstimate from_lcm(const object_pose_t& msg) {
+  ObjectPoseEstimate e;
+  e.utime = msg.utime;
+  e.valid = msg.valid;
+  if (msg.num_features < 0) {
+    throw std::invalid_argument("object_pose_t: negative num_features " + std::to_string(msg.num_features));
+  }
+  e.num_features = msg.num_features;
+  e.track_id = msg.track_id;
+  // An invalid pose's fields are meaningless and may be NaN: not checked.
+  if (!e.valid) return e;
+  e.q_OtoC = read<4>(msg.q_OtoC, "object_pose_t.q_OtoC", msg.utime);
+  e.pbar_OinC = read<3>(msg.p_OinC, "object_pose_t.p_OinC", msg.utime);
+  if (!std::isfinite(msg.reprojection_rms) || msg.reprojection_rms < 0.0) {
+    throw std::invalid_argument("object_pose_t: bad reprojection_rms at utime " + std::to_string(msg.utime));
+  }
+  e.reprojection_rms_px = msg.reprojection_rms;
+  return e;
+}
+
+// ---- scale estimator (issue 5) ---------------------------------------------
 
 scale_estimate_t to_lcm(const scale::ScaleResult& r) {
   scale_estimate_t msg{};

@@ -6,20 +6,19 @@
 
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
+#include "common/types/object_pose.h"
 #include "common/types/sensor_data.h"
 #include "common/types/target_state.h"
+#include "procs/scale_estimator/scale_estimator.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
 #include "vimot/imu_t.hpp"
 #include "vimot/nav_state_t.hpp"
-#include "vimot/target_prediction_t.hpp"
-#include "vimot/target_state_t.hpp"
-// scale estimator
-#include "common/types/object_pose.h"
-#include "procs/scale_estimator/scale_estimator.h"
 #include "vimot/metric_object_pose_t.hpp"
 #include "vimot/object_pose_t.hpp"
 #include "vimot/scale_estimate_t.hpp"
+#include "vimot/target_prediction_t.hpp"
+#include "vimot/target_state_t.hpp"
 
 namespace vimot {
 
@@ -41,11 +40,13 @@ TargetStateEstimate from_lcm(const target_state_t& msg);
 target_prediction_t to_lcm(const TargetPosePrediction& prediction);
 TargetPosePrediction from_lcm(const target_prediction_t& msg);
 
+// Object tracker (issue 5).
+object_pose_t to_lcm(const ObjectPoseEstimate& estimate);
+ObjectPoseEstimate from_lcm(const object_pose_t& msg);
+
 // --- scale estimator (issue 5): OBJECT_POSE_UPTOSCALE in, SCALE_ESTIMATE and
 // OBJECT_POSE_METRIC out.
 
-/// The pose fields are read (and checked finite) only when msg.valid.
-ObjectPoseUpToScale from_lcm(const object_pose_t& msg);
 
 scale_estimate_t to_lcm(const scale::ScaleResult& result);
 metric_object_pose_t to_lcm(const scale::ObjectPoseInWorld& pose);

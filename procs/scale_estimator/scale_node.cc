@@ -79,7 +79,7 @@ void ScaleNode::on_nav_state(const NavState& state) {
   if (!in_order(state.utime, &last_state_utime_, "VINS state")) return;
   drop_older(&object_poses_, state.utime, &stats_.stale_object_poses, "object pose");
   if (!object_poses_.empty() && object_poses_.front().utime == state.utime) {
-    const ObjectPoseUpToScale pose = object_poses_.front();
+    const ObjectPoseEstimate pose = object_poses_.front();
     object_poses_.pop_front();
     process_pair(state, pose);
     return;
@@ -95,7 +95,7 @@ void ScaleNode::on_nav_state(const NavState& state) {
   }
 }
 
-void ScaleNode::on_object_pose(const ObjectPoseUpToScale& pose) {
+void ScaleNode::on_object_pose(const ObjectPoseEstimate& pose) {
   ++stats_.object_poses_in;
   if (!in_order(pose.utime, &last_object_utime_, "object pose")) return;
   drop_older(&states_, pose.utime, &stats_.stale_states, "VINS state");
@@ -103,14 +103,21 @@ void ScaleNode::on_object_pose(const ObjectPoseUpToScale& pose) {
   if (!pose.valid) {
     ++stats_.invalid_object_poses;
     if (state_waiting) states_.pop_front();
-    if (estimator_.has_scale() || !estimator_.window().empty()) {
-      say(VinsEvent::Kind::kInfo, "object tracking lost at utime " + std::to_string(pose.utime) +
-                                      ": scale estimator reset");
+    if (!estimator_.window().empty()) {
+      say(VinsEvent::Kind::kInfo, "object tracking lost at utime " + std::to_string(pose.utime) + ": window cleared");
     }
-    estimator_.reset();
+    estimator_.clear_window();
     last_estimate_utime_.reset();
     return;
   }
+  if (track_id_ && *track_id_ != pose.track_id) {
+    ++stats_.new_tracks;
+    say(VinsEvent::Kind::kInfo, "new object track " + std::to_string(pose.track_id) + " at utime " +
+                                    std::to_string(pose.utime) + ": scale estimator reset");
+    estimator_.reset();
+    last_estimate_utime_.reset();
+  }
+  track_id_ = pose.track_id;
   if (state_waiting) {
     const NavState state = states_.front();
     states_.pop_front();
@@ -128,7 +135,7 @@ void ScaleNode::on_object_pose(const ObjectPoseUpToScale& pose) {
   }
 }
 
-void ScaleNode::process_pair(const NavState& state, const ObjectPoseUpToScale& pose) {
+void ScaleNode::process_pair(const NavState& state, const ObjectPoseEstimate& pose) {
   ++stats_.pairs;
   const CameraPoseInWorld camera = camera_pose_in_world(state.q_GtoI, state.p_IinG, options_.camera);
   scale::ScaleObservation obs;

@@ -13,11 +13,11 @@
 // stale (counted). Per channel, a utime equal to the previous one is a
 // duplicate and one before it goes backwards: both dropped and counted.
 //
-// Tracking loss: object_pose_t carries no track id, so after an invalid
-// pose the next valid one may come from a re-initialised track whose length
-// unit (the initial depth, scale paper Fig. 5) differs. An invalid pose
-// therefore resets the estimator: window and held scale. Within a track the
-// last accepted scale is held until a new one is accepted.
+// Tracking loss: an invalid object pose clears the window (finite
+// differences must not span the gap) but keeps the held scale. A new
+// track_id means a re-initialised tracker whose length unit (the initial
+// depth, scale paper Fig. 5) differs: window and held scale are reset.
+// Within a track the last accepted scale is held until a new one is accepted.
 
 #include <cstdint>
 #include <deque>
@@ -73,7 +73,8 @@ struct ScaleNodeStats {
   int64_t stale_states{0};         // dropped unmatched (other side passed them, or queue full)
   int64_t stale_object_poses{0};
   int64_t duplicate_or_backwards{0};
-  int64_t invalid_object_poses{0};  // tracking lost: each one resets the estimator
+  int64_t invalid_object_poses{0};  // tracking lost: each one clears the window
+  int64_t new_tracks{0};            // track_id changed: each one resets the estimator
   int64_t rejected_observations{0};  // pairs the core refused (non-finite, bad quaternion, time order)
   int64_t estimates{0};            // SCALE_ESTIMATE published
   int64_t metric_poses{0};         // OBJECT_POSE_METRIC published
@@ -92,7 +93,7 @@ class ScaleNode {
 
   /// Only camera-rate states (updated = true) are used; IMU-rate ones are ignored.
   void on_nav_state(const NavState& state);
-  void on_object_pose(const ObjectPoseUpToScale& pose);
+  void on_object_pose(const ObjectPoseEstimate& pose);
 
   const ScaleNodeStats& stats() const { return stats_; }
   const scale::ScaleEstimator& estimator() const { return estimator_; }
@@ -105,7 +106,7 @@ class ScaleNode {
   /// Drops queued messages older than `utime` (the other side passed them).
   template <typename T>
   void drop_older(std::deque<T>* queue, int64_t utime, int64_t* counter, const char* what);
-  void process_pair(const NavState& state, const ObjectPoseUpToScale& pose);
+  void process_pair(const NavState& state, const ObjectPoseEstimate& pose);
   void say(VinsEvent::Kind kind, const std::string& message);
 
   ScaleNodeOptions options_;
@@ -114,9 +115,10 @@ class ScaleNode {
   PoseCallback on_pose_;
   EventCallback on_event_;
   std::deque<NavState> states_;
-  std::deque<ObjectPoseUpToScale> object_poses_;
+  std::deque<ObjectPoseEstimate> object_poses_;
   std::optional<int64_t> last_state_utime_;
   std::optional<int64_t> last_object_utime_;
+  std::optional<int64_t> track_id_;  // of the last valid object pose
   std::optional<int64_t> last_estimate_utime_;
   ScaleNodeStats stats_;
 };

@@ -164,6 +164,7 @@ TEST_CASE("object_pose_t round-trips") {
   CHECK(vec(r.p_OinC) == vec(s.p_OinC));
   CHECK(r.num_features == s.num_features);
   CHECK(r.reprojection_rms == s.reprojection_rms);
+  CHECK(r.track_id == s.track_id);
   CHECK(encode(r) == encode(s));
 }
 

@@ -176,6 +176,7 @@ inline vimot::object_pose_t sample_object_pose() {
   d.fill(m.p_OinC);
   m.num_features = d.i32();
   m.reprojection_rms = d.real();
+  m.track_id = d.i64();
   return m;
 }
 

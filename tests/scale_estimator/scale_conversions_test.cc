@@ -23,7 +23,7 @@ TEST_CASE("scale conversions: object pose in, estimate and metric pose out", "[s
   msg.p_OinC[1] = -0.2;
   msg.p_OinC[2] = 1.0;
   msg.num_features = 40;
-  ObjectPoseUpToScale p = from_lcm(msg);
+  ObjectPoseEstimate p = from_lcm(msg);
   CHECK(p.utime == 123);
   CHECK(p.valid);
   CHECK(p.q_OtoC == Eigen::Vector4d(q[0], q[1], q[2], q[3]));

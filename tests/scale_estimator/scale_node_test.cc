@@ -42,8 +42,8 @@ NavState state_of(const ScaleObservation& o, const CameraCalibration& cam) {
   return s;
 }
 
-ObjectPoseUpToScale pose_of(const ScaleObservation& o) {
-  ObjectPoseUpToScale p;
+ObjectPoseEstimate pose_of(const ScaleObservation& o) {
+  ObjectPoseEstimate p;
   p.utime = o.utime;
   p.valid = true;
   p.q_OtoC = o.q_OtoC;
@@ -162,7 +162,7 @@ TEST_CASE("scale_node: a side that lags is buffered; passed or overflowing messa
   CHECK(node.stats().duplicate_or_backwards == 2);
   CHECK(node.stats().pairs == 8);
   // A NaN in a pair is refused by the core, counted, and changes nothing.
-  ObjectPoseUpToScale bad = pose_of(obs[12]);
+  ObjectPoseEstimate bad = pose_of(obs[12]);
   bad.pbar_OinC.y() = std::numeric_limits<double>::quiet_NaN();
   node.on_object_pose(bad);
   node.on_nav_state(state_of(obs[12], cam));
@@ -210,22 +210,29 @@ TEST_CASE("scale_node: held scale for the metric pose; tracking loss resets", "[
   const Eigen::Vector3d p_true = normal_object((219 + 220) * kDt).p_XinG;
   CHECK((metric.p_OinG - (p_CinG + held / kScale * (p_true - p_CinG))).norm() < 1e-9);
 
-  // Tracking lost: window and held scale forgotten, no metric pose until a
-  // new scale is accepted.
-  const std::size_t poses_before = out.poses.size();
-  ObjectPoseUpToScale lost;
+  // Tracking lost for a frame: the window is cleared (no finite difference
+  // across the gap), the held scale stays.
+  ObjectPoseEstimate lost;
   lost.utime = still.back().utime + 50000;
   lost.valid = false;
   lost.pbar_OinC.x() = std::numeric_limits<double>::quiet_NaN();  // meaningless when invalid
   node.on_object_pose(lost);
   CHECK(node.stats().invalid_object_poses == 1);
   CHECK(node.estimator().window().empty());
-  CHECK(!node.estimator().has_scale());
-  const std::vector<ScaleObservation> again = generate(normal_camera, normal_object, kScale, 199, 500);
+  CHECK(node.estimator().has_scale());
+
+  // A new track (re-initialised tracker, new length unit): window and held
+  // scale forgotten, no metric pose until a new scale is accepted.
+  const std::size_t poses_before = out.poses.size();
+  std::vector<ScaleObservation> again = generate(normal_camera, normal_object, kScale, 199, 500);
   for (const ScaleObservation& o : again) {
     node.on_nav_state(state_of(o, cam));
-    node.on_object_pose(pose_of(o));
+    ObjectPoseEstimate p = pose_of(o);
+    p.track_id = 2;
+    node.on_object_pose(p);
   }
+  CHECK(node.stats().new_tracks == 1);
+  CHECK(!node.estimator().has_scale());
   CHECK(out.poses.size() == poses_before);
   CHECK(node.estimator().window().size() == 199);
 }

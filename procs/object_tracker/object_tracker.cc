@@ -1,0 +1,678 @@
+#include "procs/object_tracker/object_tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include <ceres/ceres.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "common/math/quat.h"
+
+namespace vimot {
+
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+// The initialisation starts from a two-view guess, far from the optimum
+// compared with a tracked frame's PnP pose: it gets more iterations.
+constexpr int kInitIterationFactor = 5;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+Eigen::Vector3d homogeneous(const Eigen::Vector2d& normalized) { return {normalized.x(), normalized.y(), 1.0}; }
+
+// Eq. 2's residual: feature l, anchored in camera a by its bearing and
+// inverse depth, projected into camera j, minus its normalized observation.
+// Both poses are T_OtoC (R_OtoC as Eigen quaternion, pbar_OinC).
+struct InverseDepthReprojection {
+  InverseDepthReprojection(const Eigen::Vector3d& bearing, const Eigen::Vector2d& observed)
+      : bearing_(bearing), observed_(observed) {}
+
+  template <typename T>
+  bool operator()(const T* q_a, const T* p_a, const T* q_j, const T* p_j, const T* inverse_depth, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_OtoCa(q_a);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pbar_OinCa(p_a);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_OtoCj(q_j);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pbar_OinCj(p_j);
+    const Eigen::Matrix<T, 3, 1> p_FinCa = bearing_.cast<T>() / inverse_depth[0];
+    const Eigen::Matrix<T, 3, 1> p_FinO = q_OtoCa.conjugate() * (p_FinCa - pbar_OinCa);
+    const Eigen::Matrix<T, 3, 1> p_FinCj = q_OtoCj * p_FinO + pbar_OinCj;
+    residual[0] = p_FinCj.x() / p_FinCj.z() - T(observed_.x());
+    residual[1] = p_FinCj.y() / p_FinCj.z() - T(observed_.y());
+    return true;
+  }
+
+  Eigen::Vector3d bearing_;
+  Eigen::Vector2d observed_;
+};
+
+// Linear triangulation of X_a = d_a b_a with X_b = R X_a + t = d_b b_b
+// (least squares in the two depths); returns X_a, or nothing if either depth
+// is not positive.
+std::optional<Eigen::Vector3d> triangulate(const Eigen::Vector3d& b_a, const Eigen::Vector3d& b_b,
+                                           const Eigen::Matrix3d& R_atob, const Eigen::Vector3d& t_ainb) {
+  Eigen::Matrix<double, 3, 2> A;
+  A.col(0) = R_atob * b_a;
+  A.col(1) = -b_b;
+  const Eigen::Vector2d d = A.colPivHouseholderQr().solve(-t_ainb);
+  if (!(d(0) > 0.0) || !(d(1) > 0.0) || !std::isfinite(d(0))) return std::nullopt;
+  return Eigen::Vector3d(d(0) * b_a);
+}
+
+// Where the box centre (pixels) points: an affine map pixel -> normalized
+// fitted to this frame's target features, so the library needs no camera
+// model (distortion is smooth over a box). Falls back to the features'
+// normalized centroid if the fit is degenerate.
+Eigen::Vector3d centre_ray(const std::vector<FeatureObservation>& target, const Eigen::Vector2d& centre_px) {
+  Eigen::MatrixXd A(target.size(), 3);
+  Eigen::MatrixXd B(target.size(), 2);
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < target.size(); ++i) {
+    A.row(static_cast<Eigen::Index>(i)) << target[i].pixel.x(), target[i].pixel.y(), 1.0;
+    B.row(static_cast<Eigen::Index>(i)) = target[i].normalized.transpose();
+    centroid += target[i].normalized / static_cast<double>(target.size());
+  }
+  Eigen::Vector2d n = centroid;
+  if (target.size() >= 3) {
+    const Eigen::Matrix<double, 3, 2> M = A.colPivHouseholderQr().solve(B);
+    const Eigen::Vector2d fit = (Eigen::RowVector3d(centre_px.x(), centre_px.y(), 1.0) * M).transpose();
+    if (fit.allFinite()) n = fit;
+  }
+  return homogeneous(n).normalized();
+}
+
+}  // namespace
+
+ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
+  ObjectTrackerOptions o;
+  const std::string s = "object_tracker.";
+  o.window_size = config.get_or<int>(s + "window_size", o.window_size);
+  o.focal_length_px = config.get_or<double>(s + "focal_length_px", o.focal_length_px);
+  o.robust_loss = config.get_or<std::string>(s + "robust_loss", o.robust_loss);
+  o.robust_loss_px = config.get_or<double>(s + "robust_loss_px", o.robust_loss_px);
+  o.min_init_features = config.get_or<int>(s + "min_init_features", o.min_init_features);
+  o.min_init_parallax_deg = config.get_or<double>(s + "min_init_parallax_deg", o.min_init_parallax_deg);
+  o.init_frames = config.get_or<int>(s + "init_frames", o.init_frames);
+  o.init_min_displacement_px = config.get_or<double>(s + "init_min_displacement_px", o.init_min_displacement_px);
+  o.ransac_threshold_px = config.get_or<double>(s + "ransac_threshold_px", o.ransac_threshold_px);
+  o.reference_features = config.get_or<int>(s + "reference_features", o.reference_features);
+  o.min_track_features = config.get_or<int>(s + "min_track_features", o.min_track_features);
+  o.max_reprojection_rms_px = config.get_or<double>(s + "max_reprojection_rms_px", o.max_reprojection_rms_px);
+  o.outlier_threshold_px = config.get_or<double>(s + "outlier_threshold_px", o.outlier_threshold_px);
+  o.min_feature_parallax_deg = config.get_or<double>(s + "min_feature_parallax_deg", o.min_feature_parallax_deg);
+  o.min_feature_observations = config.get_or<int>(s + "min_feature_observations", o.min_feature_observations);
+  o.max_iterations = config.get_or<int>(s + "max_iterations", o.max_iterations);
+  o.keyframe_rotation_deg = config.get_or<double>(s + "keyframe_rotation_deg", o.keyframe_rotation_deg);
+  o.keyframe_baseline = config.get_or<double>(s + "keyframe_baseline", o.keyframe_baseline);
+  if (o.window_size < 3) throw std::invalid_argument(s + "window_size must be >= 3");
+  if (!(o.focal_length_px > 0.0)) throw std::invalid_argument(s + "focal_length_px must be > 0");
+  if (o.robust_loss != "huber" && o.robust_loss != "cauchy") {
+    throw std::invalid_argument(s + "robust_loss must be huber or cauchy, got " + o.robust_loss);
+  }
+  if (o.init_frames < 2 || o.init_frames > o.window_size) {
+    throw std::invalid_argument(s + "init_frames must be in [2, window_size]");
+  }
+  if (o.min_init_features < 8) throw std::invalid_argument(s + "min_init_features must be >= 8");
+  if (o.reference_features < 1) throw std::invalid_argument(s + "reference_features must be >= 1");
+  if (o.min_track_features < 4) throw std::invalid_argument(s + "min_track_features must be >= 4");
+  if (o.min_feature_observations < 2) throw std::invalid_argument(s + "min_feature_observations must be >= 2");
+  return o;
+}
+
+ObjectTracker::ObjectTracker(ObjectTrackerOptions options) : options_(std::move(options)) {}
+
+ObjectPoseEstimate ObjectTracker::process(const CameraFrame& frame, const std::optional<BoundingBox2d>& box) {
+  ++counters_.frames;
+  ObjectPoseEstimate invalid;
+  invalid.utime = frame.utime;
+  if (last_utime_ && frame.utime == *last_utime_) {
+    ++counters_.rejected_duplicate_time;
+    return invalid;
+  }
+  if (last_utime_ && frame.utime < *last_utime_) {
+    ++counters_.rejected_time_backwards;
+    return invalid;
+  }
+  last_utime_ = frame.utime;
+
+  std::vector<FeatureObservation> target;
+  for (const FeatureObservation& o : frame.observations) {
+    if (o.camera_id != 0 || !o.is_target) continue;
+    if (!o.pixel.allFinite() || !o.normalized.allFinite()) {
+      ++counters_.dropped_non_finite_observations;
+      continue;
+    }
+    target.push_back(o);
+  }
+  Observations obs;
+  for (const FeatureObservation& o : target) obs[o.feature_id] = o.normalized;
+
+  if (tracking_) return track(frame.utime, obs);
+  if (target.empty()) {
+    init_frames_.clear();
+    return invalid;
+  }
+  Eigen::Vector2d centre_px;
+  if (box && box->min_px.allFinite() && box->max_px.allFinite()) {
+    centre_px = 0.5 * (box->min_px + box->max_px);
+  } else {
+    Eigen::Vector2d lo = target.front().pixel, hi = lo;
+    for (const FeatureObservation& o : target) {
+      lo = lo.cwiseMin(o.pixel);
+      hi = hi.cwiseMax(o.pixel);
+    }
+    centre_px = 0.5 * (lo + hi);
+  }
+  return try_initialise(InitFrame{frame.utime, std::move(obs), centre_ray(target, centre_px)});
+}
+
+ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
+  ObjectPoseEstimate invalid;
+  invalid.utime = frame.utime;
+  // Frames join the buffer once the image has moved: the buffer then spans
+  // enough relative motion to tell rotation from translation (see below).
+  if (!init_frames_.empty()) {
+    std::vector<double> displacement;
+    for (const auto& [id, z] : frame.observations) {
+      const auto last = init_frames_.back().observations.find(id);
+      if (last != init_frames_.back().observations.end()) displacement.push_back((z - last->second).norm());
+    }
+    if (static_cast<int>(displacement.size()) >= options_.min_init_features &&
+        median(displacement) * options_.focal_length_px < options_.init_min_displacement_px) {
+      return invalid;
+    }
+  }
+  init_frames_.push_back(std::move(frame));
+  // The reference must share enough features with the current frame and
+  // stay within one window of it; otherwise the next frame becomes it.
+  while (init_frames_.size() > static_cast<std::size_t>(options_.window_size)) init_frames_.pop_front();
+  const InitFrame& cur = init_frames_.back();
+  std::vector<int64_t> ids;
+  while (init_frames_.size() >= 2) {
+    ids.clear();
+    for (const auto& [id, z] : init_frames_.front().observations) {
+      if (cur.observations.count(id)) ids.push_back(id);
+    }
+    if (static_cast<int>(ids.size()) >= options_.min_init_features) break;
+    init_frames_.pop_front();
+  }
+  if (init_frames_.size() < static_cast<std::size_t>(options_.init_frames)) return invalid;
+  const InitFrame& ref = init_frames_.front();
+
+  std::vector<cv::Point2d> p0, p1;
+  for (int64_t id : ids) {
+    const Eigen::Vector2d& a = ref.observations.at(id);
+    const Eigen::Vector2d& b = cur.observations.at(id);
+    p0.emplace_back(a.x(), a.y());
+    p1.emplace_back(b.x(), b.y());
+  }
+  const double threshold = options_.ransac_threshold_px / options_.focal_length_px;
+  cv::Mat inlier_mask;
+  cv::theRNG().state = 1;  // RANSAC samples: the same input gives the same track
+  const cv::Mat E = cv::findEssentialMat(p0, p1, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, threshold, inlier_mask);
+  if (E.rows != 3 || E.cols != 3) return invalid;
+  cv::Mat R_cv, t_cv;
+  cv::recoverPose(E, p0, p1, R_cv, t_cv, 1.0, cv::Point2d(0, 0), inlier_mask);
+  Eigen::Matrix3d R_C0toC1;
+  Eigen::Vector3d p_C0inC1;
+  cv::cv2eigen(R_cv, R_C0toC1);
+  cv::cv2eigen(t_cv, p_C0inC1);
+
+  std::vector<double> parallax;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (!inlier_mask.at<uchar>(static_cast<int>(i))) continue;
+    parallax.push_back(angle_between(R_C0toC1 * homogeneous(ref.observations.at(ids[i])),
+                                     homogeneous(cur.observations.at(ids[i]))));
+  }
+  if (static_cast<int>(parallax.size()) < options_.min_init_features ||
+      median(parallax) < options_.min_init_parallax_deg * kDegToRad) {
+    return invalid;
+  }
+
+  // Two-view reconstruction in the reference camera C0 (|p_C0inC1| = 1):
+  // the depths of the common features.
+  std::map<int64_t, double> depths;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (!inlier_mask.at<uchar>(static_cast<int>(i))) continue;
+    const std::optional<Eigen::Vector3d> X = triangulate(homogeneous(ref.observations.at(ids[i])),
+                                                         homogeneous(cur.observations.at(ids[i])), R_C0toC1, p_C0inC1);
+    if (X) depths[ids[i]] = X->z();
+  }
+  if (static_cast<int>(depths.size()) < options_.min_init_features) return invalid;
+
+  // A BA over all buffered frames from these depths, the frames after the
+  // reference posed by PnP in turn: a small object spans a narrow field of
+  // view, where two views hardly separate rotation from translation.
+  // Returns the cost per observation after the outlier removal (the two
+  // hypotheses may keep different observations); the state is left in the
+  // members.
+  const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<double> {
+    poses_.clear();
+    features_.clear();
+    window_ = {ref.utime};
+    poses_[ref.utime] = Pose{};
+    for (const auto& [id, depth] : start_depths) {
+      Feature& f = features_[id];
+      f.anchor_utime = ref.utime;
+      f.bearing = homogeneous(ref.observations.at(id));
+      f.inverse_depth = 1.0 / depth;
+      f.in_ba = true;
+      for (const InitFrame& frame : init_frames_) {
+        const auto z = frame.observations.find(id);
+        if (z != frame.observations.end()) f.observations[frame.utime] = z->second;
+      }
+    }
+    for (std::size_t k = 1; k < init_frames_.size(); ++k) {
+      const Pose pose = predict_pose(init_frames_[k].observations);
+      window_.push_back(init_frames_[k].utime);
+      poses_[init_frames_[k].utime] = pose;
+    }
+    // Only the reference pose is fixed; the scale freedom is removed by
+    // the normalisation below.
+    if (!solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
+    if (remove_outliers() > 0 && !solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
+    return last_cost_ / std::max(last_num_residuals_, 1);
+  };
+  // Under the near-affine projection of a small object the depth-reversed
+  // structure (Necker reversal: depths mirrored about their median) fits
+  // almost as well and the BA cannot leave it; both are solved and the
+  // cheaper kept.
+  const std::optional<double> cost = solve_from(depths);
+  const auto kept_poses = poses_;
+  const auto kept_features = features_;
+  const auto kept_window = window_;
+  std::vector<double> depth_values;
+  for (const auto& [id, depth] : depths) depth_values.push_back(depth);
+  const double median_depth = median(depth_values);
+  std::map<int64_t, double> reversed;
+  for (const auto& [id, depth] : depths) {
+    const double mirrored = 2.0 * median_depth - depth;
+    if (mirrored > 0.0) reversed[id] = mirrored;
+  }
+  const std::optional<double> reversed_cost =
+      static_cast<int>(reversed.size()) >= options_.min_init_features ? solve_from(reversed) : std::nullopt;
+  if (!reversed_cost || (cost && *cost <= *reversed_cost)) {
+    if (!cost) return invalid;
+    poses_ = kept_poses;
+    features_ = kept_features;
+    window_ = kept_window;
+  }
+  if (static_cast<int>(features_.size()) < options_.min_init_features) return invalid;
+
+  // Fig. 5: the surface along the centre ray is at the median distance of
+  // the features angularly nearest to the ray; that distance becomes 1.
+  std::vector<std::pair<double, int64_t>> by_angle;
+  for (const auto& [id, f] : features_) by_angle.emplace_back(angle_between(f.bearing, ref.centre_ray), id);
+  std::sort(by_angle.begin(), by_angle.end());
+  by_angle.resize(std::min(by_angle.size(), static_cast<std::size_t>(options_.reference_features)));
+  std::vector<double> distances;
+  std::vector<int64_t> reference_ids;
+  for (const auto& [angle, id] : by_angle) {
+    const Feature& f = features_.at(id);
+    distances.push_back(f.bearing.norm() / f.inverse_depth);
+    reference_ids.push_back(id);
+  }
+  const double d_ref = median(distances);
+  if (!(d_ref > 0.0) || !std::isfinite(d_ref)) return invalid;
+
+  // O: orientation of C0, origin at d_ref along the ray; unit = d_ref. A
+  // pose T_C0toC becomes R_OtoC = R_C0toC, pbar_OinC = R_C0toC u + p_C0inC/d_ref.
+  for (auto& [utime, pose] : poses_) {
+    pose.pbar_OinC = pose.q_OtoC * ref.centre_ray + pose.pbar_OinC / d_ref;
+  }
+  for (auto& [id, f] : features_) f.inverse_depth *= d_ref;
+
+  InitFacts facts;
+  facts.track_id = next_track_id_++;
+  facts.reference_utime = ref.utime;
+  facts.init_utime = cur.utime;
+  facts.centre_ray_C0 = ref.centre_ray;
+  facts.reference_feature_ids = reference_ids;
+  init_facts_ = facts;
+  ++counters_.initialisations;
+  tracking_ = true;
+  const ObjectPoseEstimate estimate = make_estimate(cur.utime, cur.observations);
+  init_frames_.clear();
+  return estimate;
+}
+
+ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) {
+  ObjectPoseEstimate invalid;
+  invalid.utime = utime;
+  const auto lose_track = [&] {
+    ++counters_.track_losses;
+    reset();
+    return invalid;
+  };
+  int tracked = 0;
+  for (const auto& [id, z] : obs) {
+    const auto it = features_.find(id);
+    if (it != features_.end() && it->second.in_ba) ++tracked;
+  }
+  if (tracked < options_.min_track_features) return lose_track();
+
+  const auto t0 = std::chrono::steady_clock::now();
+  add_observations(utime, obs, predict_pose(obs));
+  bool solved = solve_window(2, options_.max_iterations);
+  // The second removal catches what the re-solve pushed out (e.g. a new
+  // point behind a camera); it changes no estimate, so no third solve.
+  if (solved && remove_outliers() > 0) {
+    solved = solve_window(2, options_.max_iterations);
+    remove_outliers();
+  }
+  last_solve_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!solved) return lose_track();
+
+  const ObjectPoseEstimate estimate = make_estimate(utime, obs);
+  if (!estimate.valid) return lose_track();
+  slide_window();
+  return estimate;
+}
+
+ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
+  const Pose& last = poses_.at(window_.back());
+  std::vector<cv::Point3d> object_points;
+  std::vector<cv::Point2d> image_points;
+  for (const auto& [id, z] : obs) {
+    const auto it = features_.find(id);
+    if (it == features_.end() || !it->second.in_ba) continue;
+    const Eigen::Vector3d p = point_in_O(it->second);
+    object_points.emplace_back(p.x(), p.y(), p.z());
+    image_points.emplace_back(z.x(), z.y());
+  }
+  cv::Mat rvec, tvec;
+  cv::Mat R_last;
+  cv::eigen2cv(Eigen::Matrix3d(last.q_OtoC.toRotationMatrix()), R_last);
+  cv::Rodrigues(R_last, rvec);
+  cv::eigen2cv(last.pbar_OinC, tvec);
+  // A local refinement from the last pose, not a RANSAC PnP: on a small
+  // object the minimal solutions jump between the near-ambiguous (depth
+  // reversed) poses, while 50 ms of motion stays in the right basin.
+  if (object_points.size() < 4) return last;
+  cv::solvePnPRefineLM(object_points, image_points, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec);
+  cv::Mat R_cv;
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Matrix3d R_OtoC;
+  Eigen::Vector3d pbar_OinC;
+  cv::cv2eigen(R_cv, R_OtoC);
+  cv::cv2eigen(tvec, pbar_OinC);
+  if (!R_OtoC.allFinite() || !pbar_OinC.allFinite()) return last;
+  return Pose{Eigen::Quaterniond(R_OtoC), pbar_OinC};
+}
+
+void ObjectTracker::add_observations(int64_t utime, const Observations& obs, const Pose& pose) {
+  window_.push_back(utime);
+  poses_[utime] = pose;
+  // New features start at the median depth of the current points.
+  std::vector<double> depths;
+  for (const auto& [id, z] : obs) {
+    const auto it = features_.find(id);
+    if (it == features_.end() || !it->second.in_ba) continue;
+    depths.push_back((pose.q_OtoC * point_in_O(it->second) + pose.pbar_OinC).z());
+  }
+  const double depth = depths.empty() ? 1.0 : median(depths);
+  for (const auto& [id, z] : obs) {
+    Feature& f = features_[id];
+    if (f.observations.empty()) {
+      f.anchor_utime = utime;
+      f.bearing = homogeneous(z);
+      f.inverse_depth = depth > 0.0 ? 1.0 / depth : 1.0;
+    }
+    f.observations[utime] = z;
+  }
+  // A feature joins the BA once it has enough views and parallax; its
+  // inverse depth then comes from the anchor and the current view.
+  for (auto& [id, f] : features_) {
+    if (f.in_ba || !obs.count(id) || static_cast<int>(f.observations.size()) < options_.min_feature_observations) {
+      continue;
+    }
+    if (feature_parallax_rad(f) < options_.min_feature_parallax_deg * kDegToRad) continue;
+    const Pose& a = poses_.at(f.anchor_utime);
+    const Eigen::Matrix3d R_CatoC = pose.q_OtoC.toRotationMatrix() * a.q_OtoC.toRotationMatrix().transpose();
+    const Eigen::Vector3d p_CainC = pose.pbar_OinC - R_CatoC * a.pbar_OinC;
+    const std::optional<Eigen::Vector3d> X = triangulate(f.bearing, homogeneous(obs.at(id)), R_CatoC, p_CainC);
+    if (!X) continue;
+    f.inverse_depth = 1.0 / X->z();
+    f.in_ba = true;
+  }
+}
+
+bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
+  // Declared before the problem, which uses but does not own them.
+  ceres::EigenQuaternionManifold quaternion_manifold;
+  const double loss_scale = options_.robust_loss_px / options_.focal_length_px;
+  std::unique_ptr<ceres::LossFunction> loss;
+  if (options_.robust_loss == "cauchy") {
+    loss = std::make_unique<ceres::CauchyLoss>(loss_scale);
+  } else {
+    loss = std::make_unique<ceres::HuberLoss>(loss_scale);
+  }
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+
+  const auto add_pose = [&](Pose& pose) {
+    if (!problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
+      problem.AddParameterBlock(pose.q_OtoC.coeffs().data(), 4, &quaternion_manifold);
+      problem.AddParameterBlock(pose.pbar_OinC.data(), 3);
+    }
+  };
+  for (auto& [id, f] : features_) {
+    if (!f.in_ba) continue;
+    Pose& anchor = poses_.at(f.anchor_utime);
+    for (const auto& [utime, z] : f.observations) {
+      if (utime == f.anchor_utime || utime < window_.front()) continue;
+      Pose& pose = poses_.at(utime);
+      add_pose(anchor);
+      add_pose(pose);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<InverseDepthReprojection, 2, 4, 3, 4, 3, 1>(
+              new InverseDepthReprojection(f.bearing, z)),
+          loss.get(), anchor.q_OtoC.coeffs().data(), anchor.pbar_OinC.data(), pose.q_OtoC.coeffs().data(),
+          pose.pbar_OinC.data(), &f.inverse_depth);
+      // A point in front of the anchor camera; also keeps 1/rho finite.
+      problem.SetParameterLowerBound(&f.inverse_depth, 0, 1e-3);
+    }
+    if (f.frozen && problem.HasParameterBlock(&f.inverse_depth)) problem.SetParameterBlockConstant(&f.inverse_depth);
+  }
+  if (problem.NumResidualBlocks() == 0) return false;
+  // Gauge: the oldest window poses and every pose outside the window.
+  for (auto& [utime, pose] : poses_) {
+    const auto pos = std::find(window_.begin(), window_.end(), utime);
+    const bool fixed = pos == window_.end() || pos - window_.begin() < num_fixed_poses;
+    if (fixed && problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
+      problem.SetParameterBlockConstant(pose.q_OtoC.coeffs().data());
+      problem.SetParameterBlockConstant(pose.pbar_OinC.data());
+    }
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.max_num_iterations = max_iterations;
+  solver_options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return false;
+  last_cost_ = summary.final_cost;
+  last_num_residuals_ = problem.NumResidualBlocks();
+  for (auto& [utime, pose] : poses_) {
+    if (!pose.q_OtoC.coeffs().allFinite() || !pose.pbar_OinC.allFinite()) return false;
+    pose.q_OtoC.normalize();
+  }
+  return true;
+}
+
+int ObjectTracker::remove_outliers() {
+  int removed = 0;
+  for (auto it = features_.begin(); it != features_.end();) {
+    Feature& f = it->second;
+    if (!f.in_ba) {
+      ++it;
+      continue;
+    }
+    int rejected = 0;
+    int kept = 0;
+    for (auto o = f.observations.begin(); o != f.observations.end();) {
+      if (o->first == f.anchor_utime || o->first < window_.front()) {
+        ++o;
+        continue;
+      }
+      if (reprojection_error_px(f, o->first, o->second) > options_.outlier_threshold_px) {
+        o = f.observations.erase(o);
+        ++rejected;
+      } else {
+        ++o;
+        ++kept;
+      }
+    }
+    removed += rejected;
+    // Most views disagree: the anchor view (the bearing) is the outlier.
+    if (rejected > 0 && kept <= rejected) {
+      it = features_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  counters_.removed_outlier_observations += removed;
+  return removed;
+}
+
+void ObjectTracker::slide_window() {
+  const int64_t current = window_.back();
+  if (window_.size() > static_cast<std::size_t>(options_.window_size) && !is_keyframe(window_.end()[-2], window_.end()[-3])) {
+    drop_frame(window_.end()[-2]);
+  }
+  while (window_.size() > static_cast<std::size_t>(options_.window_size)) {
+    const int64_t oldest = window_.front();
+    window_.pop_front();
+    for (auto& [id, f] : features_) {
+      if (f.anchor_utime == oldest) {
+        f.frozen = true;
+      } else {
+        f.observations.erase(oldest);
+      }
+    }
+  }
+  // Feature ids are never reused after a track loss, so a candidate not seen
+  // now can never join, and a BA feature without views in the window is gone.
+  for (auto it = features_.begin(); it != features_.end();) {
+    const Feature& f = it->second;
+    const bool seen_now = f.observations.count(current) > 0;
+    const bool in_window = f.observations.lower_bound(window_.front()) != f.observations.end();
+    const bool anchor_gone = f.anchor_utime < window_.front();
+    if ((!f.in_ba && (!seen_now || anchor_gone)) || !in_window) {
+      it = features_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (auto it = poses_.begin(); it != poses_.end();) {
+    const int64_t utime = it->first;
+    const bool needed = utime >= window_.front() ||
+                        std::any_of(features_.begin(), features_.end(),
+                                    [&](const auto& kv) { return kv.second.anchor_utime == utime; });
+    it = needed ? std::next(it) : poses_.erase(it);
+  }
+}
+
+bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
+  const Pose& a = poses_.at(previous_utime);
+  const Pose& b = poses_.at(utime);
+  const Eigen::Matrix3d R_a = a.q_OtoC.toRotationMatrix();
+  const Eigen::Matrix3d R_b = b.q_OtoC.toRotationMatrix();
+  const Eigen::Vector3d p_CainO = -R_a.transpose() * a.pbar_OinC;
+  const Eigen::Vector3d p_CbinO = -R_b.transpose() * b.pbar_OinC;
+  return rotation_angle_between(R_a, R_b) >= options_.keyframe_rotation_deg * kDegToRad ||
+         (p_CbinO - p_CainO).norm() >= options_.keyframe_baseline;
+}
+
+void ObjectTracker::drop_frame(int64_t utime) {
+  const int64_t current = window_.back();
+  for (auto it = features_.begin(); it != features_.end();) {
+    Feature& f = it->second;
+    if (f.anchor_utime == utime) {
+      // Re-anchored in the current frame, where the point keeps its place.
+      const auto z = f.observations.find(current);
+      const Pose& pose = poses_.at(current);
+      const double depth = z == f.observations.end() ? -1.0 : (pose.q_OtoC * point_in_O(f) + pose.pbar_OinC).z();
+      if (depth <= 0.0) {
+        it = features_.erase(it);
+        continue;
+      }
+      f.anchor_utime = current;
+      f.bearing = homogeneous(z->second);
+      f.inverse_depth = 1.0 / depth;
+    }
+    f.observations.erase(utime);
+    ++it;
+  }
+  window_.erase(std::find(window_.begin(), window_.end(), utime));
+  poses_.erase(utime);
+}
+
+void ObjectTracker::reset() {
+  tracking_ = false;
+  window_.clear();
+  poses_.clear();
+  features_.clear();
+  init_frames_.clear();
+}
+
+Eigen::Vector3d ObjectTracker::point_in_O(const Feature& f) const {
+  const Pose& a = poses_.at(f.anchor_utime);
+  return a.q_OtoC.conjugate() * (f.bearing / f.inverse_depth - a.pbar_OinC);
+}
+
+double ObjectTracker::feature_parallax_rad(const Feature& f) const {
+  const auto& [utime, z] = *f.observations.rbegin();
+  const Eigen::Matrix3d R_CtoCa =
+      poses_.at(f.anchor_utime).q_OtoC.toRotationMatrix() * poses_.at(utime).q_OtoC.toRotationMatrix().transpose();
+  return angle_between(f.bearing, R_CtoCa * homogeneous(z));
+}
+
+double ObjectTracker::reprojection_error_px(const Feature& f, int64_t utime, const Eigen::Vector2d& z) const {
+  const Pose& pose = poses_.at(utime);
+  const Eigen::Vector3d p_FinC = pose.q_OtoC * point_in_O(f) + pose.pbar_OinC;
+  if (!(p_FinC.z() > 0.0)) return std::numeric_limits<double>::infinity();
+  return (p_FinC.head<2>() / p_FinC.z() - z).norm() * options_.focal_length_px;
+}
+
+ObjectPoseEstimate ObjectTracker::make_estimate(int64_t utime, const Observations& obs) const {
+  ObjectPoseEstimate e;
+  e.utime = utime;
+  e.track_id = init_facts_ ? init_facts_->track_id : 0;
+  const Pose& pose = poses_.at(utime);
+  double sum_sq = 0.0;
+  for (const auto& [id, z] : obs) {
+    const auto it = features_.find(id);
+    if (it == features_.end() || !it->second.in_ba || !it->second.observations.count(utime)) continue;
+    const double err = utime == it->second.anchor_utime ? 0.0 : reprojection_error_px(it->second, utime, z);
+    sum_sq += err * err;
+    ++e.num_features;
+  }
+  e.reprojection_rms_px = e.num_features > 0 ? std::sqrt(sum_sq / e.num_features) : 0.0;
+  const Eigen::Matrix3d R_OtoC = pose.q_OtoC.toRotationMatrix();
+  e.pbar_OinC = pose.pbar_OinC;
+  e.valid = e.num_features >= options_.min_track_features && e.reprojection_rms_px <= options_.max_reprojection_rms_px &&
+            R_OtoC.allFinite() && e.pbar_OinC.allFinite();
+  if (e.valid) e.q_OtoC = rot_to_quat(R_OtoC);
+  return e;
+}
+
+}  // namespace vimot

@@ -1,0 +1,273 @@
+// ObjectTracker against the simulator's truth (config/sim_mono.yaml: a
+// 0.4 x 0.3 x 0.3 m box at ~2.2 m from a hand-held camera, 20 Hz, fx = 458 px).
+//
+// Error bounds, from the geometry (not from runs):
+//  * initialisation: the two-view needs 20 buffered frames, each after 5 px
+//    of median image motion (init_frames, init_min_displacement_px). The box
+//    moves in the image at about v/Z f = 0.3 m/s / 2.2 m * 458 px ≈ 60 px/s,
+//    half that in the slow parts of the figure-eight: 100 px in ≤ 3.5 s.
+//    Valid output is required from 4 s (80 frames at 20 Hz) on.
+//  * noise-free pixels: the BA residual is zero at the truth; what is left is
+//    the solver's convergence and the undistortion (< 1e-9), far below
+//    0.01° and 1 mm (0.05 % of the 2 m range), which any modelling error
+//    (a wrong frame, sign or gauge) would exceed by orders.
+//  * 1 px noise (σ = 1/458 rad = 2.2 mrad per axis): the box spans
+//    a = 0.4 m / 2.2 m ≈ 0.18 rad and its depth relief is r = ΔZ/Z ≈ 0.14, so
+//    it projects almost affinely; rotation out of the image plane is seen
+//    only through perspective, to ≈ σ/(a r) ≈ 5° per feature and frame
+//    (bas-relief ambiguity). The gauge (O's orientation) is fixed by the
+//    initialisation window, whose errors are correlated over its frames:
+//    bound 10° RMS (twice the single-feature figure). Position: the
+//    consumer (scale estimator) needs a few %: bound 5 % of the mean range
+//    (depth is set by the reference features' median depth, triangulated
+//    with ≥ 2° of parallax: σ/θ/√5 ≈ 3 %). Scale drift end vs start: 10 %.
+//  * measured (see docs/object_tracker.md) is well inside these, except the
+//    outlier case, which is open (tagged [!mayfail]).
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <random>
+
+#include "common/config/config.h"
+#include "common/math/quat.h"
+#include "common/sim/sim_config.h"
+#include "common/sim/simulator.h"
+#include "procs/object_tracker/object_tracker.h"
+#include "tests/object_tracker/object_truth.h"
+
+namespace vimot {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+sim::SimConfig mono_config(double duration_s, double pixel_noise) {
+  sim::SimConfig c = sim::from_config(Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/sim_mono.yaml"));
+  c.duration = duration_s;
+  c.camera.pixel_noise = pixel_noise;
+  return c;
+}
+
+struct Accuracy {
+  int frames{0};
+  int valid{0};
+  double rotation_rms_deg{0.0};
+  double position_rms_m{0.0};
+  double scale_drift{0.0};  // fitted scale over the last 2 s / s_true - 1
+  double mean_range_m{0.0};
+  double mean_solve_ms{0.0};
+};
+
+struct Record {
+  ObjectPoseEstimate estimate;
+  double rotation_error_deg{0.0};
+  Eigen::Vector3d p_OinC_true{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d p_OinC_est{Eigen::Vector3d::Zero()};  // s_true * pbar_OinC
+  double s_true{0.0};
+};
+
+// Feeds every camera frame (after `modify`) to the tracker and compares each
+// valid estimate with the truth of its track.
+std::vector<Record> run(const sim::SimConfig& config, ObjectTracker& tracker,
+                        const std::function<void(CameraFrame&, double t)>& modify, double* mean_solve_ms = nullptr) {
+  sim::Simulator sim(config);
+  std::vector<Record> records;
+  std::map<int64_t, test::ObjectTruth> truths;
+  double solve_s = 0.0;
+  int solves = 0;
+  while (const std::optional<sim::SimEvent> event = sim.next()) {
+    const auto* frame = std::get_if<CameraFrame>(&*event);
+    if (!frame) continue;
+    CameraFrame input = *frame;
+    if (modify) modify(input, sim.sim_time(input.utime));
+    Record r;
+    r.estimate = tracker.process(input);
+    solve_s += tracker.last_solve_seconds();
+    ++solves;
+    if (r.estimate.valid) {
+      const InitFacts& facts = tracker.init_facts().value();
+      REQUIRE(facts.track_id == r.estimate.track_id);
+      if (!truths.count(facts.track_id)) truths[facts.track_id] = test::object_truth(sim, facts);
+      const test::ObjectTruth& truth = truths.at(facts.track_id);
+      const test::TargetInCamera x = test::true_target_in_camera(sim, r.estimate.utime);
+      r.rotation_error_deg = rotation_angle_between(quat_to_rot(r.estimate.q_OtoC), truth.R_OtoC(x)) * kRadToDeg;
+      r.p_OinC_true = truth.p_OinC(x);
+      r.p_OinC_est = truth.s_true * r.estimate.pbar_OinC;
+      r.s_true = truth.s_true;
+    }
+    records.push_back(r);
+  }
+  if (mean_solve_ms) *mean_solve_ms = 1e3 * solve_s / std::max(solves, 1);
+  return records;
+}
+
+Accuracy accuracy(const std::vector<Record>& records, int64_t track_id) {
+  Accuracy a;
+  double sum_rot = 0.0, sum_pos = 0.0, sum_range = 0.0;
+  int64_t last_utime = 0;
+  for (const Record& r : records) {
+    ++a.frames;
+    if (!r.estimate.valid || r.estimate.track_id != track_id) continue;
+    ++a.valid;
+    sum_rot += r.rotation_error_deg * r.rotation_error_deg;
+    sum_pos += (r.p_OinC_est - r.p_OinC_true).squaredNorm();
+    sum_range += r.p_OinC_true.norm();
+    last_utime = r.estimate.utime;
+  }
+  if (a.valid == 0) return a;
+  a.rotation_rms_deg = std::sqrt(sum_rot / a.valid);
+  a.position_rms_m = std::sqrt(sum_pos / a.valid);
+  a.mean_range_m = sum_range / a.valid;
+  // Least-squares scale of the last 2 s: argmin Σ |s pbar - p_true|².
+  double num = 0.0, den = 0.0, s_true = 0.0;
+  for (const Record& r : records) {
+    if (!r.estimate.valid || r.estimate.track_id != track_id || r.estimate.utime < last_utime - 2000000) continue;
+    num += r.estimate.pbar_OinC.dot(r.p_OinC_true);
+    den += r.estimate.pbar_OinC.squaredNorm();
+    s_true = r.s_true;
+  }
+  a.scale_drift = num / den / s_true - 1.0;
+  return a;
+}
+
+void print(const char* name, const Accuracy& a) {
+  std::printf("%s: %d/%d frames valid, rotation RMS %.4f deg, position RMS %.4f m (range %.2f m), scale drift %.3f %%\n",
+              name, a.valid, a.frames, a.rotation_rms_deg, a.position_rms_m, a.mean_range_m, 100.0 * a.scale_drift);
+}
+
+TEST_CASE("noise-free pixels: the tracked pose is the true one up to the scale", "[object_tracker]") {
+  ObjectTracker tracker;
+  double solve_ms = 0.0;
+  const std::vector<Record> records = run(mono_config(20.0, 0.0), tracker, {}, &solve_ms);
+  const Accuracy a = accuracy(records, 1);
+  print("noise-free", a);
+  std::printf("noise-free: mean BA time %.2f ms per frame\n", solve_ms);
+  CHECK(tracker.counters().initialisations == 1);
+  CHECK(a.valid >= a.frames - 80);
+  CHECK(a.rotation_rms_deg < 0.01);
+  CHECK(a.position_rms_m < 1e-3);
+  CHECK(std::abs(a.scale_drift) < 1e-3);
+}
+
+TEST_CASE("1 px noise: rotation and position within the geometric bounds", "[object_tracker]") {
+  ObjectTracker tracker;
+  double solve_ms = 0.0;
+  const std::vector<Record> records = run(mono_config(25.0, 1.0), tracker, {}, &solve_ms);
+  const Accuracy a = accuracy(records, 1);
+  print("1 px", a);
+  std::printf("1 px: mean BA time %.2f ms per frame\n", solve_ms);
+  CHECK(tracker.counters().initialisations == 1);
+  CHECK(a.valid >= a.frames - 80);
+  CHECK(a.rotation_rms_deg < 10.0);
+  CHECK(a.position_rms_m < 0.05 * a.mean_range_m);
+  CHECK(std::abs(a.scale_drift) < 0.10);
+}
+
+TEST_CASE("a 1 s gap without target observations gives a new track, accurate again", "[object_tracker]") {
+  ObjectTracker tracker;
+  const auto gap = [](double t) { return t >= 8.0 && t < 9.0; };
+  const std::vector<Record> records = run(mono_config(20.0, 1.0), tracker, [&](CameraFrame& f, double t) {
+    if (gap(t)) f.observations.clear();
+  });
+  sim::Simulator sim(mono_config(20.0, 1.0));
+  int valid_in_gap = 0;
+  int64_t max_track_before = 0;
+  for (const Record& r : records) {
+    const double t = sim.sim_time(r.estimate.utime);
+    if (gap(t) && r.estimate.valid) ++valid_in_gap;
+    if (t < 8.0 && r.estimate.valid) max_track_before = std::max(max_track_before, r.estimate.track_id);
+  }
+  CHECK(valid_in_gap == 0);
+  CHECK(max_track_before == 1);
+  CHECK(tracker.counters().track_losses >= 1);
+  REQUIRE(tracker.init_facts().has_value());
+  CHECK(tracker.init_facts()->track_id == 2);
+  CHECK(tracker.init_facts()->reference_utime >= sim.camera_utime(0) + 9000000);
+  const Accuracy second = accuracy(records, 2);
+  print("after the gap", second);
+  // The new track re-initialises within 4 s (as at the start) and has the
+  // accuracy bounds of the 1 px case.
+  CHECK(second.valid >= 20 * 11 - 80);
+  CHECK(second.rotation_rms_deg < 10.0);
+  CHECK(second.position_rms_m < 0.05 * second.mean_range_m);
+}
+
+// Open: with these outliers the initialisation takes ~12 s and then settles
+// in the depth-reversed solution (docs/object_tracker.md, "Open issues").
+TEST_CASE("5 % of the target observations 20 px off: the robust BA stays accurate", "[object_tracker][!mayfail]") {
+  ObjectTracker tracker;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double focal_px = tracker.options().focal_length_px;
+  const std::vector<Record> records = run(mono_config(20.0, 1.0), tracker, [&](CameraFrame& f, double) {
+    for (FeatureObservation& o : f.observations) {
+      if (!o.is_target || uniform(rng) >= 0.05) continue;
+      const double angle = 2.0 * M_PI * uniform(rng);
+      const Eigen::Vector2d offset_px = 20.0 * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      o.pixel += offset_px;
+      o.normalized += offset_px / focal_px;
+    }
+  });
+  const Accuracy a = accuracy(records, 1);
+  print("5 % outliers", a);
+  CHECK(tracker.counters().removed_outlier_observations > 0);
+  CHECK(tracker.counters().initialisations == 1);
+  CHECK(a.valid >= a.frames - 80);
+  CHECK(a.rotation_rms_deg < 10.0);
+  CHECK(a.position_rms_m < 0.05 * a.mean_range_m);
+}
+
+TEST_CASE("bad input is counted and never crashes", "[object_tracker]") {
+  ObjectTracker tracker;
+  sim::Simulator sim(mono_config(20.0, 1.0));
+  CameraFrame previous;
+  int frames = 0;
+  while (const std::optional<sim::SimEvent> event = sim.next()) {
+    const auto* frame = std::get_if<CameraFrame>(&*event);
+    if (!frame) continue;
+    CameraFrame input = *frame;
+    for (FeatureObservation& o : input.observations) {
+      if (o.is_target) {
+        o.pixel.x() = std::nan("");
+        o.normalized.x() = std::nan("");
+        break;
+      }
+    }
+    tracker.process(input);
+    if (frames > 0) {
+      const ObjectPoseEstimate duplicate = tracker.process(input);
+      const ObjectPoseEstimate backwards = tracker.process(previous);
+      CHECK_FALSE(duplicate.valid);
+      CHECK_FALSE(backwards.valid);
+    }
+    previous = input;
+    ++frames;
+  }
+  CHECK(tracker.counters().dropped_non_finite_observations == frames);
+  CHECK(tracker.counters().rejected_duplicate_time == frames - 1);
+  CHECK(tracker.counters().rejected_time_backwards == frames - 1);
+  CHECK(tracker.counters().initialisations == 1);
+  // An empty frame and a frame of NaNs only: invalid, no crash.
+  CameraFrame empty;
+  empty.utime = previous.utime + 50000;
+  CHECK_FALSE(tracker.process(empty).valid);
+}
+
+TEST_CASE("options from a YAML section, with validation", "[object_tracker]") {
+  const ObjectTrackerOptions defaults;
+  const ObjectTrackerOptions o = object_tracker_options_from_config(
+      Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/object_tracker.yaml"));
+  CHECK(o.window_size == 20);
+  CHECK(o.robust_loss == defaults.robust_loss);
+  CHECK(o.min_init_features == defaults.min_init_features);
+  CHECK_THROWS_AS(object_tracker_options_from_config(Config::from_string("object_tracker: {robust_loss: l2}")),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(object_tracker_options_from_config(Config::from_string("object_tracker: {window_size: 2}")),
+                  std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace vimot
