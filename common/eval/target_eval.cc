@@ -451,6 +451,42 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
   return j.str();
 }
 
+std::vector<TargetCell> read_target_cells(const std::string& summary_json) {
+  try {
+    const JsonValue doc = JsonValue::parse(read_text_file(summary_json));
+    const JsonValue& cells = doc.at("cells");
+    std::vector<TargetCell> out;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      const JsonValue& c = cells.at(i);
+      TargetCell cell;
+      cell.vio_only = c.at("mode").string() == "vio";
+      if (!cell.vio_only) {
+        cell.filter.mode = parse_target_mode(c.at("mode").string());
+        cell.filter.representation = parse_target_representation(c.at("representation").string());
+        cell.filter.sigma_t = c.at("sigma_t").number();
+      }
+      const JsonValue& runs = c.at("per_run");
+      for (std::size_t k = 0; k < runs.size(); ++k) {
+        const JsonValue& r = runs.at(k);
+        TargetRunResult run;
+        run.sim_seed = static_cast<uint64_t>(r.at("sim_seed").number());
+        run.perturb_seed = static_cast<uint64_t>(r.at("perturb_seed").number());
+        run.diverged = r.at("diverged").boolean();
+        if (run.diverged && r.has("divergence_reason")) run.divergence_reason = r.at("divergence_reason").string();
+        run.target_in_imu = summary_from_json(r.at("target_in_imu"));
+        run.target_in_world = summary_from_json(r.at("target_in_world"));
+        run.imu = summary_from_json(r.at("imu"));
+        run.wall_s = r.at("wall_s").number();
+        cell.runs.push_back(run);
+      }
+      out.push_back(std::move(cell));
+    }
+    return out;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("'" + summary_json + "': " + e.what());
+  }
+}
+
 std::string target_summary_csv(const std::vector<TargetCell>& cells) {
   std::ostringstream out;
   out << "mode,representation,sigma_t,run,diverged,"

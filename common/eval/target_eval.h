@@ -124,6 +124,12 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
                                 const std::string& vins_config, const std::string& target_config,
                                 const TargetSweepOptions& o, double wall_s);
 
+/// The cells of a summary.json written by target_summary_json (per-run
+/// figures; options beyond mode, representation and σ_t are not stored), so
+/// sweeps run in parts can be tabulated together. Throws std::runtime_error
+/// naming the file.
+std::vector<TargetCell> read_target_cells(const std::string& summary_json);
+
 /// summary.csv: one row per cell and run, then per cell a row run = "mean".
 std::string target_summary_csv(const std::vector<TargetCell>& cells);
 

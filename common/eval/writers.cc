@@ -107,6 +107,16 @@ void write_summary_json(JsonWriter& json, const ErrorSummary& s) {
   json.end_object();
 }
 
+ErrorSummary summary_from_json(const JsonValue& o) {
+  ErrorSummary s;
+  s.rmse_position_m = o.at("rmse_position_m").number();
+  s.rmse_orientation_deg = o.at("rmse_orientation_deg").number();
+  s.nees_position = o.at("nees_position").number();
+  s.nees_orientation = o.at("nees_orientation").number();
+  s.count = static_cast<int64_t>(o.at("samples").number());
+  return s;
+}
+
 ErrorSummary read_summary_json(const std::string& path, const std::string& key) {
   const std::string text = read_text_file(path);
   try {
@@ -120,14 +130,7 @@ ErrorSummary read_summary_json(const std::string& path, const std::string& key) 
       node = index && !node->is_object() ? &node->at(static_cast<std::size_t>(std::stoul(part))) : &node->at(part);
       begin = end + 1;
     }
-    const JsonValue& o = *node;
-    ErrorSummary s;
-    s.rmse_position_m = o.at("rmse_position_m").number();
-    s.rmse_orientation_deg = o.at("rmse_orientation_deg").number();
-    s.nees_position = o.at("nees_position").number();
-    s.nees_orientation = o.at("nees_orientation").number();
-    s.count = static_cast<int64_t>(o.at("samples").number());
-    return s;
+    return summary_from_json(*node);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("'" + path + "' (object '" + key + "'): " + e.what());
   }

@@ -53,6 +53,10 @@ std::vector<ErrorSample> errors_of(const std::vector<FrameSample>& samples);
 /// writer's current position.
 void write_summary_json(JsonWriter& json, const ErrorSummary& summary);
 
+/// The ErrorSummary of an object written with write_summary_json. Throws
+/// std::runtime_error on a missing key or a wrong type.
+ErrorSummary summary_from_json(const JsonValue& object);
+
 /// Reads the object at `key` of a JSON file written with write_summary_json
 /// (e.g. key "summary"; a path "cells/1/per_run/0/target_in_imu" walks
 /// objects and arrays). Throws std::runtime_error naming the file and key.

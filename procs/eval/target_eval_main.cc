@@ -37,6 +37,38 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
+// --merge: the tables of several earlier --out folders as one sweep.
+int merge(const ArgParser& args) {
+  std::vector<eval::TargetCell> cells;
+  for (const std::string& dir : split(args.get("merge"))) {
+    for (eval::TargetCell& c : eval::read_target_cells(dir + "/summary.json")) cells.push_back(std::move(c));
+  }
+  if (cells.empty()) throw ArgError("--merge: no cells in " + args.get("merge"));
+  std::cout << eval::target_tables(cells);
+  int runs = 0;
+  double wall = 0.0;
+  for (const auto& c : cells) {
+    for (const auto& r : c.runs) {
+      ++runs;
+      wall += r.wall_s;
+    }
+  }
+  std::cout << "\n" << cells.size() << " cells, " << runs << " runs merged from " << args.get("merge") << " ("
+            << eval::hms(wall) << " of single-thread run time)\n";
+  const std::string out_dir = args.get("out");
+  if (!out_dir.empty()) {
+    std::filesystem::create_directories(out_dir);
+    eval::TargetSweepOptions o;
+    o.runs = static_cast<int>(cells.front().runs.size());
+    eval::write_text_file(out_dir + "/summary.json",
+                          eval::target_summary_json(cells, args.get("sim-config"), args.get("vins-config"),
+                                                    args.get("target-config"), o, wall));
+    eval::write_text_file(out_dir + "/summary.csv", eval::target_summary_csv(cells));
+    std::cout << "wrote " << out_dir << "/{summary.json, summary.csv}\n";
+  }
+  return 0;
+}
+
 int run(int argc, const char* const* argv) {
   ArgParser args("vimot-target-eval",
                  "Monte-Carlo σ_t sweep of the joint robot + target filter on the simulator (paper\n"
@@ -58,6 +90,10 @@ int run(int argc, const char* const* argv) {
   args.add_option("threads", "K", "parallel runs (0 = hardware concurrency)", "0");
   args.add_option("duration", "SECONDS", "simulate only this long (default: the config's)");
   args.add_option("out", "DIR", "write summary.json and summary.csv");
+  args.add_option("merge", "DIRS",
+                  "run nothing: tabulate the comma-separated --out folders of earlier runs together\n"
+                  "(a sweep run in parts, e.g. one σ_t per run); with --out also writes the merged\n"
+                  "summary.json / summary.csv");
   args.add_option("perturb-seed", "P",
                   "perturbation seed of the start for every run instead of one derived from the simulator\n"
                   "seed (e.g. the vins config's init.perturb_seed, to reproduce an LCM run); 0 = the truth");
@@ -71,6 +107,7 @@ int run(int argc, const char* const* argv) {
   set_log_name("target-eval");
   set_log_level(parse_log_level(args.get("log-level")));
 
+  if (args.given("merge")) return merge(args);
   const std::string sim_path = args.get("sim-config");
   const std::string vins_path = args.get("vins-config");
   const std::string target_path = args.get("target-config");

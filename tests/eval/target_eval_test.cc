@@ -5,11 +5,13 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "common/config/config.h"
 #include "common/eval/target_eval.h"
 #include "common/eval/vins_config.h"
+#include "common/eval/writers.h"
 #include "common/sim/simulator.h"
 
 using namespace vimot;
@@ -99,6 +101,20 @@ TEST_CASE("target sweep: SKF leaves the IMU RMSE of VIO only; thread count does 
   CHECK(tables.find("Table II (SKF)") != std::string::npos);
   CHECK(tables.find("VIO only") != std::string::npos);
   CHECK(target_summary_csv(a).find("skf,local,0.05,4,0") != std::string::npos);
+
+  // A sweep run in parts is tabulated together from its summary.json files:
+  // the cells read back give the same tables and CSV.
+  const std::string json_path = "/tmp/vimot_target_eval_test_summary.json";
+  write_text_file(json_path, target_summary_json(a, "sim", "vins", "target", one_cell(1), 1.0));
+  const std::vector<TargetCell> back = read_target_cells(json_path);
+  REQUIRE(back.size() == a.size());
+  CHECK(back[0].vio_only);
+  CHECK(back[1].filter.mode == target::TargetUpdateMode::kSkf);
+  CHECK(back[1].filter.sigma_t == 0.05);
+  CHECK(target_tables(back) == tables);
+  CHECK(target_summary_csv(back) == target_summary_csv(a));
+  std::remove(json_path.c_str());
+  CHECK_THROWS_AS(read_target_cells("/nonexistent/summary.json"), std::runtime_error);
 }
 
 TEST_CASE("target config: keys and errors", "[eval][target]") {
