@@ -1,0 +1,88 @@
+#pragma once
+// The monocular metric-scale pipeline of the scale paper (Qiu et al.,
+// Sec. III-IV) on the simulator, offline and in-process, evaluated against
+// its truth (vimot-scale-eval). The same cores as the LCM processes, fed in
+// the same order: per camera frame VioEstimator (mono) -> NavState,
+// ObjectTracker -> up-to-scale object pose, ScaleNode (pairing by utime,
+// correlation estimator, held scale, Eq. 20-21). No LCM here.
+//
+// Truth per tracker track (procs/eval/object_truth.h): s_true and the object
+// frame O rigid in the target T. Reported as the paper reports its trials:
+//  * scale: relative error ŝ/s_true − 1 of every accepted estimate (median,
+//    max |·|) and of the scale held at the end;
+//  * object in world (each published metric pose, Eq. 21): error p̂_OinG −
+//    p_OinG per axis of G, mean and standard deviation (m); orientation
+//    error R̂_OtoG R_OtoGᵀ as yaw (about z of G), pitch, roll (ZYX), mean and
+//    standard deviation (rad).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/estimator/vio_estimator.h"
+#include "common/eval/metrics.h"
+#include "common/sim/sim_config.h"
+#include "procs/object_tracker/object_tracker.h"
+#include "procs/scale_estimator/scale_node.h"
+
+namespace vimot {
+namespace eval {
+
+struct ScaleEvalOptions {
+  estimator::VioOptions vio;
+  ObjectTrackerOptions tracker;
+  ScaleNodeOptions node;
+};
+
+/// One published metric object pose against the truth.
+struct MetricPoseSample {
+  int64_t utime{0};
+  double scale{0.0};       // the held scale used
+  double scale_true{0.0};  // s_true of the track
+  Eigen::Vector3d err_p{Eigen::Vector3d::Zero()};    // m, p̂_OinG − p_OinG (G)
+  Eigen::Vector3d err_ypr{Eigen::Vector3d::Zero()};  // rad, yaw, pitch, roll of R̂_OtoG R_OtoGᵀ
+};
+
+struct MeanStd3 {
+  Eigen::Vector3d mean{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d std{Eigen::Vector3d::Zero()};  // sample standard deviation (n − 1)
+};
+MeanStd3 mean_std3(const std::vector<Eigen::Vector3d>& values);
+
+struct ScaleRunResult {
+  uint64_t sim_seed{0};
+  uint64_t perturb_seed{0};
+  int64_t frames{0};
+  int64_t tracker_valid_frames{0};
+  int64_t tracks{0};
+  int64_t estimates{0};          // SCALE_ESTIMATE
+  int64_t accepted{0};
+  std::vector<double> accepted_scale_errors;  // ŝ/s_true − 1 of the accepted estimates
+  double final_scale_error{0.0};              // of the scale held at the end (NaN if none)
+  std::vector<MetricPoseSample> metric_poses;
+  MeanStd3 position_error;     // m, over metric_poses
+  MeanStd3 orientation_error;  // rad, yaw / pitch / roll
+  ErrorSummary vio;            // camera-rate VIO accuracy (as vimot-vio-eval)
+  double tracker_ms_mean{0.0};
+  bool vio_diverged{false};
+  std::string divergence_reason;
+  double wall_s{0.0};
+};
+
+/// One run on `sim_config` (mono scenario with a target). perturb_seed 0 =
+/// the VIO starts at the truth. `progress` gets the fraction of frames done.
+/// Throws std::invalid_argument on a scenario without a target or camera.
+ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEvalOptions& options,
+                                uint64_t perturb_seed, const std::function<void(double)>& progress = {});
+
+/// The median of |errors| and the largest |error|; zeros when empty.
+struct AbsStats {
+  double median{0.0};
+  double max{0.0};
+};
+AbsStats abs_stats(const std::vector<double>& errors);
+
+}  // namespace eval
+}  // namespace vimot
