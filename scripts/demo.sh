@@ -1,18 +1,26 @@
 #!/usr/bin/env bash
 # The README's main job: the simulated scenario through the LCM stack.
-# Installs what is missing, builds, starts the processes of
-# sheriff_configs/sim_demo.pmd with vimot-sheriff (simulator, vins, the
-# target filter, lcm-logger), and prints a summary: processes, messages per channel, the
-# VIO and target accuracy of the LCM run against ground truth, the same scenario
-# run offline (in-process, same libraries) for comparison, and the log path.
+#   scripts/demo.sh        stereo target tracking (Schmidt-EKF paper)
+#   scripts/demo.sh mono   monocular metric scale (scale paper)
+# Installs what is missing, builds, starts the processes of a sheriff config
+# with vimot-sheriff and prints a summary: processes, messages per channel,
+# the accuracy of the LCM run against ground truth, the same scenario run
+# offline (in-process, same libraries) for comparison, and the log path.
+#  - default: sheriff_configs/sim_demo.pmd (simulator, vins, the target
+#    filter, lcm-logger): VIO and target accuracy.
+#  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
+#    scale estimator, lcm-logger): VIO accuracy, scale error and the metric
+#    object pose error in the world.
 #
 # Environment (all optional):
-#   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml)
+#   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
+#                     sim_mono.yaml)
 #   VIMOT_SPEED       simulator real-time factor (default 4; on 2 cores, 10 is
 #                     too fast for the target filter: UDP drops messages and
 #                     the LCM figures no longer equal the offline ones)
 #   VIMOT_SEED        noise seed (default 1)
-#   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml)
+#   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml; mono:
+#                     vins_mono.yaml)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
 #   LCM_DEFAULT_URL   LCM network (default
 #                     udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304: never
@@ -23,15 +31,26 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${VIMOT_BUILD_DIR:-$here/build}"
 
+pipeline=target
 case "${1:-}" in
   -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+  mono) pipeline=mono ;;
+  "") ;;
+  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono' or --help)" >&2; exit 1 ;;
 esac
 
 "$here/scripts/build.sh"
 
 export VIMOT_BIN="$build/bin"
 export VIMOT_CONFIG="$here/config"
-export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
+if [ $pipeline = mono ]; then
+  pmd="$here/sheriff_configs/sim_mono.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_mono.yaml}"
+  export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
+else
+  pmd="$here/sheriff_configs/sim_demo.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
+fi
 export VIMOT_SPEED="${VIMOT_SPEED:-4}"
 export VIMOT_SEED="${VIMOT_SEED:-1}"
 export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins.yaml}"
@@ -41,12 +60,11 @@ mkdir -p "$out"
 export VIMOT_LOG="$out/demo.lcmlog"
 
 echo "== vimot demo: $VIMOT_SIM_CONFIG at ${VIMOT_SPEED}x real time, seed $VIMOT_SEED"
-echo "== processes (sheriff_configs/sim_demo.pmd):"
-"$VIMOT_BIN/vimot-sheriff" --list "$here/sheriff_configs/sim_demo.pmd" | sed 's/^/   /'
+echo "== processes ($(basename "$pmd")):"
+"$VIMOT_BIN/vimot-sheriff" --list "$pmd" | sed 's/^/   /'
 echo "== running (output in $out/sheriff.txt)"
 set +e
-"$VIMOT_BIN/vimot-sheriff" --script run --exit-when sim "$here/sheriff_configs/sim_demo.pmd" \
-  > "$out/sheriff.txt" 2>&1
+"$VIMOT_BIN/vimot-sheriff" --script run --exit-when sim "$pmd" > "$out/sheriff.txt" 2>&1
 status=$?
 set -e
 grep -E '\[sim\].*(scenario|done|stopped)' "$out/sheriff.txt" | sed 's/^/   /' || true
@@ -66,6 +84,19 @@ perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VI
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --json "$out/lcm_summary.json" \
   --compare "$out/offline/summary.json" | sed 's/^/   /'
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
+if [ $pipeline = mono ]; then
+  echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC vs GROUND_TRUTH), and the offline run:"
+  "$VIMOT_BIN/vimot-scale-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+    --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --tracker-config "$VIMOT_CONFIG/object_tracker.yaml" \
+    --scale-config "$VIMOT_CONFIG/scale_estimator.yaml" --runs 1 --first-seed "$VIMOT_SEED" \
+    --perturb-seed "${perturb_seed:-0}" --out "$out/offline_scale" --quiet > "$out/offline_scale.txt" 2>&1 || true
+  "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --scale-truth "$out/offline_scale/summary.json" \
+    | grep -E '^(scale|metric|compare|  (scale|accepted|last|object))' | sed 's/^/   /'
+  echo "   (offline run: $out/offline_scale.txt)"
+  echo "== log: $VIMOT_LOG"
+  echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
+  exit 0
+fi
 echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal VINS_STATE):"
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE \
   --compare "$out/lcm_summary.json" | sed 's/^/   /'

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/math/quat.h"
+
 namespace vimot {
 
 namespace {
@@ -313,6 +315,39 @@ metric_object_pose_t to_lcm(const scale::ObjectPoseInWorld& pose) {
   write<4>(pose.q_GtoO, msg.q_GtoO);
   write<3>(pose.p_OinG, msg.p_OinG);
   return msg;
+}
+
+scale::ScaleResult from_lcm(const scale_estimate_t& msg) {
+  scale::ScaleResult r;
+  r.utime = msg.utime;
+  r.scale = msg.scale;  // NaN allowed: s* undefined (see ScaleResult)
+  r.accepted = msg.accepted;
+  if (r.accepted && !(std::isfinite(msg.scale) && msg.scale > 0.0)) {
+    throw std::invalid_argument("scale_estimate_t: accepted with scale " + std::to_string(msg.scale) + " at utime " +
+                                std::to_string(msg.utime));
+  }
+  r.f_value = msg.f_value;
+  for (int k = 0; k < 3; ++k) {
+    r.condition[k] = msg.condition[k];
+    r.condition_ok[k] = msg.condition_ok[k];
+  }
+  r.failed_condition = msg.failed_condition;
+  r.num_observations = msg.num_observations;
+  return r;
+}
+
+scale::ObjectPoseInWorld from_lcm(const metric_object_pose_t& msg) {
+  scale::ObjectPoseInWorld p;
+  p.utime = msg.utime;
+  p.scale = msg.scale;
+  if (!(std::isfinite(msg.scale) && msg.scale > 0.0)) {
+    throw std::invalid_argument("metric_object_pose_t: scale " + std::to_string(msg.scale) + " at utime " +
+                                std::to_string(msg.utime));
+  }
+  p.q_GtoO = quat_normalize(read<4>(msg.q_GtoO, "metric_object_pose_t.q_GtoO", msg.utime));
+  p.R_OtoG = quat_to_rot(p.q_GtoO).transpose();
+  p.p_OinG = read<3>(msg.p_OinG, "metric_object_pose_t.p_OinG", msg.utime);
+  return p;
 }
 
 }  // namespace vimot

@@ -50,5 +50,8 @@ ObjectPoseEstimate from_lcm(const object_pose_t& msg);
 
 scale_estimate_t to_lcm(const scale::ScaleResult& result);
 metric_object_pose_t to_lcm(const scale::ObjectPoseInWorld& pose);
+scale::ScaleResult from_lcm(const scale_estimate_t& msg);
+/// p_OinC is not in the message (left zero).
+scale::ObjectPoseInWorld from_lcm(const metric_object_pose_t& msg);
 
 }  // namespace vimot

@@ -1,10 +1,12 @@
 #include "procs/eval/log_eval.h"
 
 #include <lcm/lcm-cpp.hpp>
+#include <map>
 #include <stdexcept>
 
 #include "common/eval/json.h"
 #include "common/eval/writers.h"
+#include "common/math/quat.h"
 
 #include "common/process/lcm_conversions.h"
 
@@ -50,6 +52,10 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
 
   LogEvalResult r;
   TruthMatcher matcher;
+  const bool scale_on = !options.scale_channel.empty();
+  std::vector<scale::ScaleResult> estimates;
+  std::vector<scale::ObjectPoseInWorld> metric_poses;
+  std::map<int64_t, GroundTruth> target_truths;  // for the metric poses
   auto malformed = [&r](int64_t* counter, const lcm::LogEvent& ev, const std::string& why) {
     ++*counter;
     if (r.first_malformed.empty()) {
@@ -81,6 +87,28 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
       } catch (const std::invalid_argument& e) {
         malformed(&r.malformed_targets, *ev, e.what());
       }
+    } else if (scale_on && ev->channel == options.scale_channel) {
+      scale_estimate_t msg;
+      if (!decode(*ev, &msg, &why)) {
+        malformed(&r.malformed_scale, *ev, why);
+        continue;
+      }
+      try {
+        estimates.push_back(from_lcm(msg));
+      } catch (const std::invalid_argument& e) {
+        malformed(&r.malformed_scale, *ev, e.what());
+      }
+    } else if (scale_on && ev->channel == options.metric_channel) {
+      metric_object_pose_t msg;
+      if (!decode(*ev, &msg, &why)) {
+        malformed(&r.malformed_scale, *ev, why);
+        continue;
+      }
+      try {
+        metric_poses.push_back(from_lcm(msg));
+      } catch (const std::invalid_argument& e) {
+        malformed(&r.malformed_scale, *ev, e.what());
+      }
     } else if (ev->channel == options.truth_channel) {
       ground_truth_t msg;
       if (!decode(*ev, &msg, &why)) {
@@ -88,7 +116,9 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
         continue;
       }
       try {
-        matcher.add_truth(from_lcm(msg));
+        const GroundTruth truth = from_lcm(msg);
+        if (scale_on && truth.has_target) target_truths.emplace(truth.utime, truth);
+        matcher.add_truth(truth);
       } catch (const std::invalid_argument& e) {
         malformed(&r.malformed_truths, *ev, e.what());
       }
@@ -105,6 +135,21 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
     for (const ErrorSample& s : r.target_samples.target_in_world) in_world.add(s);
     r.target_in_imu = in_imu.summary();
     r.target_in_world = in_world.summary();
+  }
+  if (scale_on) {
+    ScaleFigureBuilder figures;
+    for (const TrackTruth& t : options.tracks) figures.start_track(t.start_utime, t.truth);
+    for (const scale::ScaleResult& e : estimates) figures.add_estimate(e.utime, e.scale, e.accepted);
+    for (const scale::ObjectPoseInWorld& p : metric_poses) {
+      const auto it = target_truths.find(p.utime);
+      if (it == target_truths.end()) {
+        ++r.metric_without_truth;
+        continue;
+      }
+      figures.add_metric_pose(p.utime, p.scale, p.R_OtoG, p.p_OinG, quat_to_rot(it->second.q_GtoT).transpose(),
+                              it->second.p_TinG);
+    }
+    r.scale = figures.figures();
   }
   return r;
 }

@@ -13,6 +13,7 @@
 
 #include "common/eval/metrics.h"
 #include "common/eval/truth_matcher.h"
+#include "procs/eval/scale_eval.h"
 
 namespace vimot {
 namespace eval {
@@ -21,6 +22,13 @@ struct LogEvalOptions {
   std::string state_channel{"VINS_STATE"};
   std::string truth_channel{"GROUND_TRUTH"};
   std::string target_channel;  // target_state_t; empty: no target evaluation
+  // Monocular scale pipeline: scale_estimate_t and metric_object_pose_t
+  // against the truth of the tracker's tracks (from vimot-scale-eval's
+  // summary.json of the same seed: the object frame O is defined by the
+  // tracker's initialisation, which the log does not carry).
+  std::string scale_channel;   // empty: no scale evaluation
+  std::string metric_channel;
+  std::vector<TrackTruth> tracks;
 };
 
 struct LogEvalResult {
@@ -37,6 +45,9 @@ struct LogEvalResult {
   TargetMatch target_samples;
   TargetMatchCounts target_counts;
   int64_t malformed_targets{0};
+  ScaleFigures scale;
+  int64_t malformed_scale{0};   // on scale_channel or metric_channel
+  int64_t metric_without_truth{0};
 };
 
 /// Index in "cells" of the first target-filter cell (not VIO-only) of a

@@ -40,6 +40,13 @@ int run(int argc, const char* const* argv) {
   args.add_option("compare-target", "SUMMARY_JSON",
                   "with --target-channel: print the relative difference of the target figures to a\n"
                   "one-run vimot-target-eval summary.json (its first target-filter cell)");
+  args.add_option("scale-truth", "SUMMARY_JSON",
+                  "evaluate the monocular scale pipeline too: SCALE_ESTIMATE and OBJECT_POSE_METRIC\n"
+                  "against the truth of the object tracks in this one-run vimot-scale-eval summary.json\n"
+                  "of the same seed (the log cannot define the tracker's object frame), and print the\n"
+                  "relative difference to that run's figures");
+  args.add_option("scale-channel", "CHANNEL", "scale_estimate_t channel", "SCALE_ESTIMATE");
+  args.add_option("metric-channel", "CHANNEL", "metric_object_pose_t channel", "OBJECT_POSE_METRIC");
   args.add_option("json", "FILE", "write the summary as JSON (object \"summary\", as vimot-vio-eval's)");
   args.add_option("csv", "FILE", "write the per-sample errors with 3-sigma bounds (as vimot-vio-eval's)");
   args.add_option("compare", "SUMMARY_JSON", "print the relative difference to this summary (e.g. an offline run)");
@@ -51,6 +58,11 @@ int run(int argc, const char* const* argv) {
   opt.state_channel = args.get("state-channel");
   opt.truth_channel = args.get("truth-channel");
   opt.target_channel = args.get("target-channel");
+  if (args.given("scale-truth")) {
+    opt.scale_channel = args.get("scale-channel");
+    opt.metric_channel = args.get("metric-channel");
+    opt.tracks = eval::read_track_truths(args.get("scale-truth"), 0);
+  }
   if (args.given("compare-target") && opt.target_channel.empty()) {
     throw ArgError("--compare-target needs --target-channel");
   }
@@ -107,6 +119,22 @@ int run(int argc, const char* const* argv) {
     }
   }
 
+  if (!opt.scale_channel.empty()) {
+    const eval::ScaleFigures& f = r.scale;
+    const eval::AbsStats a = eval::abs_stats(f.accepted_scale_errors);
+    std::printf("scale estimates on %s: %lld (accepted %lld, malformed %lld); scale error median %.2f %%, max %.2f %%, "
+                "last accepted %.2f %%\n",
+                opt.scale_channel.c_str(), static_cast<long long>(f.estimates), static_cast<long long>(f.accepted),
+                static_cast<long long>(r.malformed_scale), 100.0 * a.median, 100.0 * a.max,
+                100.0 * f.final_scale_error);
+    std::printf("metric object poses on %s: %lld (without truth %lld); position error std %.4f / %.4f / %.4f m, "
+                "yaw/pitch/roll std %.4f / %.4f / %.4f rad\n",
+                opt.metric_channel.c_str(), static_cast<long long>(f.metric_poses.size()),
+                static_cast<long long>(r.metric_without_truth), f.position_error.std(0), f.position_error.std(1),
+                f.position_error.std(2), f.orientation_error.std(0), f.orientation_error.std(1),
+                f.orientation_error.std(2));
+  }
+
   int status = s.count > 0 ? 0 : 2;
   if (!opt.target_channel.empty() && r.target_in_imu.count == 0) status = 2;
   const double tol = args.given("tolerance") ? args.get_double("tolerance") : -1.0;
@@ -151,6 +179,20 @@ int run(int argc, const char* const* argv) {
                         {"target NEES position", ln.nees_position, on.nees_position},
                         {"target NEES orientation", ln.nees_orientation, on.nees_orientation},
                         {"target samples", static_cast<double>(li.count), static_cast<double>(oi.count)}});
+  }
+  if (!opt.scale_channel.empty()) {
+    const eval::ScaleFigures o = eval::read_scale_figures(args.get("scale-truth"), 0);
+    const eval::ScaleFigures& f = r.scale;
+    print_compare(args.get("scale-truth"),
+                  {{"scale estimates", static_cast<double>(f.estimates), static_cast<double>(o.estimates)},
+                   {"accepted estimates", static_cast<double>(f.accepted), static_cast<double>(o.accepted)},
+                   {"last accepted scale error", f.final_scale_error, o.final_scale_error},
+                   {"object position std x [m]", f.position_error.std(0), o.position_error.std(0)},
+                   {"object position std y [m]", f.position_error.std(1), o.position_error.std(1)},
+                   {"object position std z [m]", f.position_error.std(2), o.position_error.std(2)},
+                   {"object yaw std [rad]", f.orientation_error.std(0), o.orientation_error.std(0)},
+                   {"object pitch std [rad]", f.orientation_error.std(1), o.orientation_error.std(1)},
+                   {"object roll std [rad]", f.orientation_error.std(2), o.orientation_error.std(2)}});
   }
   return status;
 }

@@ -4,16 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <optional>
 #include <stdexcept>
 #include <variant>
 
 #include "common/eval/initial_estimate.h"
 #include "common/eval/nav_state_of.h"
+#include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/sim/simulator.h"
-#include "procs/eval/object_truth.h"
 
 namespace vimot {
 namespace eval {
@@ -26,7 +25,36 @@ Eigen::Vector3d yaw_pitch_roll(const Eigen::Matrix3d& R) {
                          std::atan2(R(2, 1), R(2, 2)));
 }
 
+void write_vec(JsonWriter& j, const std::string& key, const Eigen::Vector3d& v) {
+  j.key(key).begin_array();
+  for (int i = 0; i < 3; ++i) j.value(v(i));
+  j.end_array();
+}
+
+Eigen::Vector3d read_vec(const JsonValue& a) {
+  if (a.size() != 3) throw std::runtime_error("expected 3 numbers");
+  return Eigen::Vector3d(a.at(std::size_t{0}).number(), a.at(std::size_t{1}).number(), a.at(std::size_t{2}).number());
+}
+
+const JsonValue& run_object(const JsonValue& doc, std::size_t run) {
+  const JsonValue& runs = doc.at("per_run");
+  if (run >= runs.size()) throw std::runtime_error("no run " + std::to_string(run) + " in per_run");
+  return runs.at(run);
+}
+
 }  // namespace
+
+MetricPoseSample metric_pose_error(int64_t utime, double scale, const Eigen::Matrix3d& R_OtoG,
+                                   const Eigen::Vector3d& p_OinG, const ObjectTruth& truth,
+                                   const Eigen::Matrix3d& R_TtoG, const Eigen::Vector3d& p_TinG) {
+  MetricPoseSample m;
+  m.utime = utime;
+  m.scale = scale;
+  m.scale_true = truth.s_true;
+  m.err_p = p_OinG - (R_TtoG * truth.p_OinT + p_TinG);
+  m.err_ypr = yaw_pitch_roll(R_OtoG * (R_TtoG * truth.R_OtoT).transpose());
+  return m;
+}
 
 MeanStd3 mean_std3(const std::vector<Eigen::Vector3d>& values) {
   MeanStd3 r;
@@ -51,6 +79,51 @@ AbsStats abs_stats(const std::vector<double>& errors) {
   return s;
 }
 
+void ScaleFigureBuilder::start_track(int64_t utime, const ObjectTruth& truth) {
+  if (!tracks_.empty() && utime <= tracks_.back().first) {
+    throw std::invalid_argument("ScaleFigureBuilder: tracks must start in time order");
+  }
+  tracks_.emplace_back(utime, truth);
+}
+
+const ObjectTruth* ScaleFigureBuilder::truth_at(int64_t utime) const {
+  const ObjectTruth* t = nullptr;
+  for (const auto& [start, truth] : tracks_) {
+    if (start <= utime) t = &truth;
+  }
+  return t;
+}
+
+void ScaleFigureBuilder::add_estimate(int64_t utime, double scale, bool accepted) {
+  ++f_.estimates;
+  const ObjectTruth* truth = truth_at(utime);
+  if (!accepted || truth == nullptr) return;
+  ++f_.accepted;
+  f_.accepted_scale_errors.push_back(scale / truth->s_true - 1.0);
+}
+
+void ScaleFigureBuilder::add_metric_pose(int64_t utime, double scale, const Eigen::Matrix3d& R_OtoG,
+                                         const Eigen::Vector3d& p_OinG, const Eigen::Matrix3d& R_TtoG,
+                                         const Eigen::Vector3d& p_TinG) {
+  if (const ObjectTruth* truth = truth_at(utime)) {
+    f_.metric_poses.push_back(metric_pose_error(utime, scale, R_OtoG, p_OinG, *truth, R_TtoG, p_TinG));
+  }
+}
+
+ScaleFigures ScaleFigureBuilder::figures() const {
+  ScaleFigures f = f_;
+  f.final_scale_error = f.accepted_scale_errors.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                                        : f.accepted_scale_errors.back();
+  std::vector<Eigen::Vector3d> p, o;
+  for (const MetricPoseSample& m : f.metric_poses) {
+    p.push_back(m.err_p);
+    o.push_back(m.err_ypr);
+  }
+  f.position_error = mean_std3(p);
+  f.orientation_error = mean_std3(o);
+  return f;
+}
+
 ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEvalOptions& options,
                                 uint64_t perturb_seed, const std::function<void(double)>& progress) {
   const auto wall_start = std::chrono::steady_clock::now();
@@ -66,39 +139,13 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
   const InitialEstimate x0 = initial_estimate(sim.initial_state(), options.vio, perturb_seed);
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
   ObjectTracker tracker(options.tracker);
-
-  // Truth of each track, keyed by track id (the tracker re-initialises).
-  std::map<int64_t, ObjectTruth> truths;
-  std::vector<double> scale_true_of_estimate;
-  std::vector<Eigen::Vector3d> err_p, err_ypr;
-  int64_t current_track = 0;
-  std::optional<double> held_scale_error;
+  ScaleFigureBuilder figures;
+  auto true_target = [&sim](int64_t utime) { return sim.target_state(sim.sim_time(utime)).value(); };
   ScaleNode node(
-      options.node,
-      [&](const scale::ScaleResult& s) {
-        ++r.estimates;
-        const auto it = truths.find(current_track);
-        if (!s.accepted || it == truths.end()) return;
-        ++r.accepted;
-        r.accepted_scale_errors.push_back(s.scale / it->second.s_true - 1.0);
-        held_scale_error = r.accepted_scale_errors.back();
-      },
+      options.node, [&](const scale::ScaleResult& s) { figures.add_estimate(s.utime, s.scale, s.accepted); },
       [&](const scale::ObjectPoseInWorld& pose) {
-        const auto it = truths.find(current_track);
-        if (it == truths.end()) return;
-        const ObjectTruth& truth = it->second;
-        const sim::SplineState target = sim.target_state(sim.sim_time(pose.utime)).value();
-        const Eigen::Matrix3d R_OtoG_true = target.R_BtoG * truth.R_OtoT;
-        const Eigen::Vector3d p_OinG_true = target.R_BtoG * truth.p_OinT + target.p_BinG;
-        MetricPoseSample m;
-        m.utime = pose.utime;
-        m.scale = pose.scale;
-        m.scale_true = truth.s_true;
-        m.err_p = pose.p_OinG - p_OinG_true;
-        m.err_ypr = yaw_pitch_roll(pose.R_OtoG * R_OtoG_true.transpose());
-        r.metric_poses.push_back(m);
-        err_p.push_back(m.err_p);
-        err_ypr.push_back(m.err_ypr);
+        const sim::SplineState target = true_target(pose.utime);
+        figures.add_metric_pose(pose.utime, pose.scale, pose.R_OtoG, pose.p_OinG, target.R_BtoG, target.p_BinG);
       },
       {});
 
@@ -131,11 +178,11 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
     tracker_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (pose.valid) {
       ++r.tracker_valid_frames;
-      if (truths.count(pose.track_id) == 0 && tracker.init_facts()) {
-        truths[pose.track_id] = object_truth(sim, *tracker.init_facts());
-        ++r.tracks;
+      if ((r.tracks.empty() || r.tracks.back().track_id != pose.track_id) && tracker.init_facts()) {
+        TrackTruth t{pose.track_id, pose.utime, object_truth(sim, *tracker.init_facts())};
+        figures.start_track(t.start_utime, t.truth);
+        r.tracks.push_back(t);
       }
-      current_track = pose.track_id;
     }
     if (st != estimator::FrameStatus::kProcessed) continue;
     const NavState nav = nav_state_of(est, true);
@@ -145,12 +192,85 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
   }
   if (progress) progress(1.0);
   r.vio = vio_errors.summary();
-  r.position_error = mean_std3(err_p);
-  r.orientation_error = mean_std3(err_ypr);
-  r.final_scale_error = held_scale_error.value_or(std::numeric_limits<double>::quiet_NaN());
+  r.figures = figures.figures();
   r.tracker_ms_mean = r.frames > 0 ? 1e3 * tracker_s / static_cast<double>(r.frames) : 0.0;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return r;
+}
+
+void write_scale_run_json(JsonWriter& j, const ScaleRunResult& r) {
+  const ScaleFigures& f = r.figures;
+  const AbsStats s = abs_stats(f.accepted_scale_errors);
+  j.begin_object();
+  j.field("sim_seed", r.sim_seed).field("perturb_seed", r.perturb_seed).field("frames", r.frames);
+  j.field("tracker_valid_frames", r.tracker_valid_frames);
+  j.field("estimates", f.estimates).field("accepted", f.accepted);
+  j.field("scale_error_median", s.median).field("scale_error_max", s.max);
+  j.field("final_scale_error", f.final_scale_error);
+  j.field("metric_poses", static_cast<int64_t>(f.metric_poses.size()));
+  write_vec(j, "position_error_mean_m", f.position_error.mean);
+  write_vec(j, "position_error_std_m", f.position_error.std);
+  write_vec(j, "ypr_error_mean_rad", f.orientation_error.mean);
+  write_vec(j, "ypr_error_std_rad", f.orientation_error.std);
+  j.key("vio");
+  write_summary_json(j, r.vio);
+  j.field("tracker_ms_mean", r.tracker_ms_mean).field("vio_diverged", r.vio_diverged).field("wall_s", r.wall_s);
+  j.key("tracks").begin_array();
+  for (const TrackTruth& t : r.tracks) {
+    j.begin_object();
+    j.field("track_id", t.track_id).field("start_utime", t.start_utime).field("s_true", t.truth.s_true);
+    write_vec(j, "p_OinT", t.truth.p_OinT);
+    j.key("q_OtoT").begin_array();
+    const Eigen::Vector4d q = rot_to_quat(t.truth.R_OtoT);
+    for (int i = 0; i < 4; ++i) j.value(q(i));
+    j.end_array();
+    j.end_object();
+  }
+  j.end_array();
+  j.end_object();
+}
+
+std::vector<TrackTruth> read_track_truths(const std::string& summary_json, std::size_t run) {
+  try {
+    const JsonValue doc = JsonValue::parse(read_text_file(summary_json));
+    const JsonValue& tracks = run_object(doc, run).at("tracks");
+    std::vector<TrackTruth> out;
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      const JsonValue& t = tracks.at(i);
+      TrackTruth tt;
+      tt.track_id = static_cast<int64_t>(t.at("track_id").number());
+      tt.start_utime = static_cast<int64_t>(t.at("start_utime").number());
+      tt.truth.s_true = t.at("s_true").number();
+      tt.truth.p_OinT = read_vec(t.at("p_OinT"));
+      const JsonValue& q = t.at("q_OtoT");
+      if (q.size() != 4) throw std::runtime_error("q_OtoT: expected 4 numbers");
+      Eigen::Vector4d qv;
+      for (std::size_t k = 0; k < 4; ++k) qv(static_cast<int>(k)) = q.at(k).number();
+      tt.truth.R_OtoT = quat_to_rot(quat_normalize(qv));
+      out.push_back(tt);
+    }
+    return out;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("'" + summary_json + "': " + e.what());
+  }
+}
+
+ScaleFigures read_scale_figures(const std::string& summary_json, std::size_t run) {
+  try {
+    const JsonValue doc = JsonValue::parse(read_text_file(summary_json));
+    const JsonValue& r = run_object(doc, run);
+    ScaleFigures f;
+    f.estimates = static_cast<int64_t>(r.at("estimates").number());
+    f.accepted = static_cast<int64_t>(r.at("accepted").number());
+    f.final_scale_error = r.at("final_scale_error").number();
+    f.position_error.mean = read_vec(r.at("position_error_mean_m"));
+    f.position_error.std = read_vec(r.at("position_error_std_m"));
+    f.orientation_error.mean = read_vec(r.at("ypr_error_mean_rad"));
+    f.orientation_error.std = read_vec(r.at("ypr_error_std_rad"));
+    return f;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("'" + summary_json + "': " + e.what());
+  }
 }
 
 }  // namespace eval

@@ -19,11 +19,14 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/estimator/vio_estimator.h"
+#include "common/eval/json.h"
 #include "common/eval/metrics.h"
 #include "common/sim/sim_config.h"
+#include "procs/eval/object_truth.h"
 #include "procs/object_tracker/object_tracker.h"
 #include "procs/scale_estimator/scale_node.h"
 
@@ -45,25 +48,61 @@ struct MetricPoseSample {
   Eigen::Vector3d err_ypr{Eigen::Vector3d::Zero()};  // rad, yaw, pitch, roll of R̂_OtoG R_OtoGᵀ
 };
 
+/// The error of one metric object pose (R̂_OtoG, p̂_OinG) against the truth:
+/// the track's object frame in T and the true target pose (R_TtoG, p_TinG).
+MetricPoseSample metric_pose_error(int64_t utime, double scale, const Eigen::Matrix3d& R_OtoG,
+                                   const Eigen::Vector3d& p_OinG, const ObjectTruth& truth,
+                                   const Eigen::Matrix3d& R_TtoG, const Eigen::Vector3d& p_TinG);
+
 struct MeanStd3 {
   Eigen::Vector3d mean{Eigen::Vector3d::Zero()};
   Eigen::Vector3d std{Eigen::Vector3d::Zero()};  // sample standard deviation (n − 1)
 };
 MeanStd3 mean_std3(const std::vector<Eigen::Vector3d>& values);
 
+/// The figures of a run (offline or from an LCM log, see vimot-log-eval).
+struct ScaleFigures {
+  int64_t estimates{0};                       // SCALE_ESTIMATE
+  int64_t accepted{0};
+  std::vector<double> accepted_scale_errors;  // ŝ/s_true − 1 of the accepted estimates
+  double final_scale_error{0.0};              // of the last accepted estimate (NaN if none)
+  std::vector<MetricPoseSample> metric_poses;
+  MeanStd3 position_error;     // m, over metric_poses
+  MeanStd3 orientation_error;  // rad, yaw / pitch / roll
+};
+
+/// Accumulates estimates and metric poses into ScaleFigures; the truth of
+/// each tracker track is given as the track starts.
+class ScaleFigureBuilder {
+ public:
+  /// Metric poses and estimates from `utime` on belong to this track.
+  void start_track(int64_t utime, const ObjectTruth& truth);
+  void add_estimate(int64_t utime, double scale, bool accepted);
+  void add_metric_pose(int64_t utime, double scale, const Eigen::Matrix3d& R_OtoG, const Eigen::Vector3d& p_OinG,
+                       const Eigen::Matrix3d& R_TtoG, const Eigen::Vector3d& p_TinG);
+  ScaleFigures figures() const;
+
+ private:
+  const ObjectTruth* truth_at(int64_t utime) const;
+  std::vector<std::pair<int64_t, ObjectTruth>> tracks_;  // (start utime, truth), increasing
+  ScaleFigures f_;
+};
+
+/// A track's truth and where it starts, as written to vimot-scale-eval's
+/// summary.json (so an LCM run of the same seed can be evaluated with it).
+struct TrackTruth {
+  int64_t track_id{0};
+  int64_t start_utime{0};  // first valid object pose of the track
+  ObjectTruth truth;
+};
+
 struct ScaleRunResult {
   uint64_t sim_seed{0};
   uint64_t perturb_seed{0};
   int64_t frames{0};
   int64_t tracker_valid_frames{0};
-  int64_t tracks{0};
-  int64_t estimates{0};          // SCALE_ESTIMATE
-  int64_t accepted{0};
-  std::vector<double> accepted_scale_errors;  // ŝ/s_true − 1 of the accepted estimates
-  double final_scale_error{0.0};              // of the scale held at the end (NaN if none)
-  std::vector<MetricPoseSample> metric_poses;
-  MeanStd3 position_error;     // m, over metric_poses
-  MeanStd3 orientation_error;  // rad, yaw / pitch / roll
+  std::vector<TrackTruth> tracks;
+  ScaleFigures figures;
   ErrorSummary vio;            // camera-rate VIO accuracy (as vimot-vio-eval)
   double tracker_ms_mean{0.0};
   bool vio_diverged{false};
@@ -83,6 +122,14 @@ struct AbsStats {
   double max{0.0};
 };
 AbsStats abs_stats(const std::vector<double>& errors);
+
+/// One run as an object of vimot-scale-eval's summary.json ("per_run"):
+/// its figures and its tracks' truth.
+void write_scale_run_json(JsonWriter& json, const ScaleRunResult& run);
+/// Run `run` of a summary.json: its tracks' truth, and its figures (without
+/// the per-pose samples). Throw std::runtime_error naming the file.
+std::vector<TrackTruth> read_track_truths(const std::string& summary_json, std::size_t run);
+ScaleFigures read_scale_figures(const std::string& summary_json, std::size_t run);
 
 }  // namespace eval
 }  // namespace vimot

@@ -29,35 +29,11 @@ namespace {
 
 using namespace vimot;
 
-void write_vec(eval::JsonWriter& j, const std::string& key, const Eigen::Vector3d& v) {
-  j.key(key).begin_array();
-  for (int i = 0; i < 3; ++i) j.value(v(i));
-  j.end_array();
-}
-
-void write_run_json(eval::JsonWriter& j, const eval::ScaleRunResult& r) {
-  const eval::AbsStats s = eval::abs_stats(r.accepted_scale_errors);
-  j.begin_object();
-  j.field("sim_seed", r.sim_seed).field("perturb_seed", r.perturb_seed).field("frames", r.frames);
-  j.field("tracker_valid_frames", r.tracker_valid_frames).field("tracks", r.tracks);
-  j.field("estimates", r.estimates).field("accepted", r.accepted);
-  j.field("scale_error_median", s.median).field("scale_error_max", s.max);
-  j.field("final_scale_error", r.final_scale_error).field("metric_poses", static_cast<int64_t>(r.metric_poses.size()));
-  write_vec(j, "position_error_mean_m", r.position_error.mean);
-  write_vec(j, "position_error_std_m", r.position_error.std);
-  write_vec(j, "ypr_error_mean_rad", r.orientation_error.mean);
-  write_vec(j, "ypr_error_std_rad", r.orientation_error.std);
-  j.key("vio");
-  eval::write_summary_json(j, r.vio);
-  j.field("tracker_ms_mean", r.tracker_ms_mean).field("vio_diverged", r.vio_diverged).field("wall_s", r.wall_s);
-  j.end_object();
-}
-
 void write_metric_csv(const std::string& path, const eval::ScaleRunResult& r) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write '" + path + "'");
   f << "t,scale,scale_true,err_px,err_py,err_pz,err_yaw,err_pitch,err_roll\n";
-  for (const auto& m : r.metric_poses) {
+  for (const auto& m : r.figures.metric_poses) {
     f << eval::utime_to_seconds_string(m.utime) << ',' << m.scale << ',' << m.scale_true;
     for (int i = 0; i < 3; ++i) f << ',' << m.err_p(i);
     for (int i = 0; i < 3; ++i) f << ',' << m.err_ypr(i);
@@ -143,23 +119,24 @@ int run(int argc, const char* const* argv) {
   double sum_med = 0.0, sum_end = 0.0;
   int with_scale = 0;
   for (const eval::ScaleRunResult& r : results) {
-    const eval::AbsStats s = eval::abs_stats(r.accepted_scale_errors);
+    const eval::ScaleFigures& f = r.figures;
+    const eval::AbsStats s = eval::abs_stats(f.accepted_scale_errors);
     std::printf("%-5llu %8.1f%% %6lld %9lld %9lld   %5.2f/%5.2f/%6.2f %%   %7.4f %7.4f %7.4f   %7.4f %7.4f %7.4f %9.4f %8.2f\n",
                 static_cast<unsigned long long>(r.sim_seed),
                 100.0 * static_cast<double>(r.tracker_valid_frames) / static_cast<double>(std::max<int64_t>(1, r.frames)),
-                static_cast<long long>(r.tracks), static_cast<long long>(r.estimates),
-                static_cast<long long>(r.accepted), 100.0 * s.median, 100.0 * s.max, 100.0 * r.final_scale_error,
-                r.position_error.std(0), r.position_error.std(1), r.position_error.std(2), r.orientation_error.std(0),
-                r.orientation_error.std(1), r.orientation_error.std(2), r.vio.rmse_position_m, r.tracker_ms_mean);
-    if (r.vio_diverged || r.accepted == 0) {
+                static_cast<long long>(r.tracks.size()), static_cast<long long>(f.estimates),
+                static_cast<long long>(f.accepted), 100.0 * s.median, 100.0 * s.max, 100.0 * f.final_scale_error,
+                f.position_error.std(0), f.position_error.std(1), f.position_error.std(2), f.orientation_error.std(0),
+                f.orientation_error.std(1), f.orientation_error.std(2), r.vio.rmse_position_m, r.tracker_ms_mean);
+    if (r.vio_diverged || f.accepted == 0) {
       status = 2;
       continue;
     }
     ++with_scale;
-    sum_pstd += r.position_error.std;
-    sum_ostd += r.orientation_error.std;
+    sum_pstd += f.position_error.std;
+    sum_ostd += f.orientation_error.std;
     sum_med += s.median;
-    sum_end += std::abs(r.final_scale_error);
+    sum_end += std::abs(f.final_scale_error);
   }
   if (with_scale > 0) {
     const double n = with_scale;
@@ -180,7 +157,7 @@ int run(int argc, const char* const* argv) {
     j.field("scale_config", args.get("scale-config")).field("runs", static_cast<int64_t>(runs));
     j.field("first_seed", static_cast<int64_t>(first)).field("wall_s", wall);
     j.key("per_run").begin_array();
-    for (const auto& r : results) write_run_json(j, r);
+    for (const auto& r : results) eval::write_scale_run_json(j, r);
     j.end_array();
     j.end_object();
     eval::write_text_file(out_dir + "/summary.json", j.str());
