@@ -232,6 +232,70 @@ TEST_CASE("Log evaluation of target states: both frames, NEES in the filter's re
   std::remove(path.c_str());
 }
 
+TEST_CASE("Log evaluation of the scale pipeline: estimates and metric poses against the tracks' truth",
+          "[eval][log]") {
+  // Target at p_TinG = (t, 0, 0) m (t in ms), yawed 0.2 rad; object frame O
+  // at p_OinT = (0.1, 0, 0) with R_OtoT = I; s_true = 2.
+  auto truth_with_target = [](int64_t utime) {
+    GroundTruth gt = truth_at(utime);
+    gt.has_target = true;
+    gt.q_GtoT = rot_to_quat(exp_so3(Eigen::Vector3d(0, 0, 0.2)).transpose());
+    gt.p_TinG = Eigen::Vector3d(1e-3 * static_cast<double>(utime), 0, 0);
+    return gt;
+  };
+  TrackTruth track;
+  track.track_id = 1;
+  track.start_utime = 100;
+  track.truth.s_true = 2.0;
+  track.truth.p_OinT = Eigen::Vector3d(0.1, 0, 0);
+  auto metric_at = [&](int64_t utime, const Eigen::Vector3d& err_p, double yaw_err) {
+    const GroundTruth gt = truth_with_target(utime);
+    const Eigen::Matrix3d R_TtoG = quat_to_rot(gt.q_GtoT).transpose();
+    scale::ObjectPoseInWorld p;
+    p.utime = utime;
+    p.scale = 2.1;
+    p.R_OtoG = exp_so3(Eigen::Vector3d(0, 0, yaw_err)) * R_TtoG;
+    p.q_GtoO = rot_to_quat(p.R_OtoG.transpose());
+    p.p_OinG = R_TtoG * track.truth.p_OinT + gt.p_TinG + err_p;
+    return to_lcm(p);
+  };
+  auto estimate_at = [](int64_t utime, double scale, bool accepted) {
+    scale::ScaleResult r;
+    r.utime = utime;
+    r.scale = scale;
+    r.accepted = accepted;
+    return to_lcm(r);
+  };
+  const std::string path = temp_path("scale");
+  {
+    LogWriter w(path);
+    for (int64_t t = 100; t <= 400; t += 100) w.write("GROUND_TRUTH", to_lcm(truth_with_target(t)), t);
+    w.write("SCALE_ESTIMATE", estimate_at(50, 5.0, true), 50);    // before the track: no truth
+    w.write("SCALE_ESTIMATE", estimate_at(200, 2.1, true), 200);  // +5 %
+    w.write("SCALE_ESTIMATE", estimate_at(300, 9.0, false), 300);
+    w.write("OBJECT_POSE_METRIC", metric_at(200, Eigen::Vector3d(0.01, 0, 0), 0.01), 200);
+    w.write("OBJECT_POSE_METRIC", metric_at(300, Eigen::Vector3d(0.03, 0, 0), 0.03), 300);
+    w.write("OBJECT_POSE_METRIC", metric_at(350, Eigen::Vector3d::Zero(), 0.0), 350);  // no truth at 350
+    w.raw("OBJECT_POSE_METRIC", {1, 2, 3}, 360);                                       // corrupt
+  }
+  LogEvalOptions o;
+  o.scale_channel = "SCALE_ESTIMATE";
+  o.metric_channel = "OBJECT_POSE_METRIC";
+  o.tracks = {track};
+  const LogEvalResult r = evaluate_log(path, o);
+  CHECK(r.malformed_scale == 1);
+  CHECK(r.metric_without_truth == 1);
+  CHECK(r.scale.estimates == 3);
+  CHECK(r.scale.accepted == 1);
+  CHECK_THAT(r.scale.final_scale_error, WithinAbs(0.05, 1e-12));
+  REQUIRE(r.scale.metric_poses.size() == 2);
+  CHECK_THAT(r.scale.position_error.mean(0), WithinAbs(0.02, 1e-12));
+  CHECK_THAT(r.scale.position_error.std(0), WithinAbs(std::sqrt(2.0) * 0.01, 1e-12));
+  CHECK_THAT(r.scale.orientation_error.mean(0), WithinAbs(0.02, 1e-12));
+  CHECK_THAT(r.scale.orientation_error.std(0), WithinAbs(std::sqrt(2.0) * 0.01, 1e-12));
+  std::remove(path.c_str());
+}
+
 TEST_CASE("An offline run through LCM messages evaluates identically", "[eval][log]") {
   const std::string src = VIMOT_SOURCE_DIR;
   sim::SimConfig cfg = sim::from_config(Config::load_file(src + "/config/sim_paper.yaml"));
