@@ -22,6 +22,9 @@ constexpr double kDegToRad = M_PI / 180.0;
 // The initialisation starts from a two-view guess, far from the optimum
 // compared with a tracked frame's PnP pose: it gets more iterations.
 constexpr int kInitIterationFactor = 5;
+// Floor of the pixel noise in the initialisation's hypothesis test, so that
+// noise-free input gives a finite chi-square gap.
+constexpr double kMinNoisePx = 0.01;
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -108,7 +111,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.min_init_features = config.get_or<int>(s + "min_init_features", o.min_init_features);
   o.min_init_parallax_deg = config.get_or<double>(s + "min_init_parallax_deg", o.min_init_parallax_deg);
   o.init_frames = config.get_or<int>(s + "init_frames", o.init_frames);
-  o.init_min_displacement_px = config.get_or<double>(s + "init_min_displacement_px", o.init_min_displacement_px);
+  o.init_min_chi2_gap = config.get_or<double>(s + "init_min_chi2_gap", o.init_min_chi2_gap);
   o.ransac_threshold_px = config.get_or<double>(s + "ransac_threshold_px", o.ransac_threshold_px);
   o.reference_features = config.get_or<int>(s + "reference_features", o.reference_features);
   o.min_track_features = config.get_or<int>(s + "min_track_features", o.min_track_features);
@@ -124,8 +127,8 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   if (o.robust_loss != "huber" && o.robust_loss != "cauchy") {
     throw std::invalid_argument(s + "robust_loss must be huber or cauchy, got " + o.robust_loss);
   }
-  if (o.init_frames < 2 || o.init_frames > o.window_size) {
-    throw std::invalid_argument(s + "init_frames must be in [2, window_size]");
+  if (o.init_frames < 2) {
+    throw std::invalid_argument(s + "init_frames must be >= 2");
   }
   if (o.min_init_features < 8) throw std::invalid_argument(s + "min_init_features must be >= 8");
   if (o.reference_features < 1) throw std::invalid_argument(s + "reference_features must be >= 1");
@@ -184,23 +187,11 @@ ObjectPoseEstimate ObjectTracker::process(const CameraFrame& frame, const std::o
 ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   ObjectPoseEstimate invalid;
   invalid.utime = frame.utime;
-  // Frames join the buffer once the image has moved: the buffer then spans
-  // enough relative motion to tell rotation from translation (see below).
-  if (!init_frames_.empty()) {
-    std::vector<double> displacement;
-    for (const auto& [id, z] : frame.observations) {
-      const auto last = init_frames_.back().observations.find(id);
-      if (last != init_frames_.back().observations.end()) displacement.push_back((z - last->second).norm());
-    }
-    if (static_cast<int>(displacement.size()) >= options_.min_init_features &&
-        median(displacement) * options_.focal_length_px < options_.init_min_displacement_px) {
-      return invalid;
-    }
-  }
+  // Every frame is buffered: with the camera looking at the object, the
+  // target hardly moves in the image, yet its view direction changes, and
+  // that rotation is what resolves the structure of a small object.
   init_frames_.push_back(std::move(frame));
-  // The reference must share enough features with the current frame and
-  // stay within one window of it; otherwise the next frame becomes it.
-  while (init_frames_.size() > static_cast<std::size_t>(options_.window_size)) init_frames_.pop_front();
+  while (init_frames_.size() > static_cast<std::size_t>(options_.init_frames)) init_frames_.pop_front();
   const InitFrame& cur = init_frames_.back();
   std::vector<int64_t> ids;
   while (init_frames_.size() >= 2) {
@@ -261,7 +252,11 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   // Returns the cost per observation after the outlier removal (the two
   // hypotheses may keep different observations); the state is left in the
   // members.
-  const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<double> {
+  struct Fit {
+    double cost_per_observation;
+    int observations;
+  };
+  const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<Fit> {
     poses_.clear();
     features_.clear();
     window_ = {ref.utime};
@@ -286,13 +281,13 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     // the normalisation below.
     if (!solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
     if (remove_outliers() > 0 && !solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
-    return last_cost_ / std::max(last_num_residuals_, 1);
+    return Fit{last_cost_ / std::max(last_num_residuals_, 1), last_num_residuals_};
   };
   // Under the near-affine projection of a small object the depth-reversed
   // structure (Necker reversal: depths mirrored about their median) fits
   // almost as well and the BA cannot leave it; both are solved and the
   // cheaper kept.
-  const std::optional<double> cost = solve_from(depths);
+  const std::optional<Fit> fit = solve_from(depths);
   const auto kept_poses = poses_;
   const auto kept_features = features_;
   const auto kept_window = window_;
@@ -304,10 +299,24 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     const double mirrored = 2.0 * median_depth - depth;
     if (mirrored > 0.0) reversed[id] = mirrored;
   }
-  const std::optional<double> reversed_cost =
+  const std::optional<Fit> reversed_fit =
       static_cast<int>(reversed.size()) >= options_.min_init_features ? solve_from(reversed) : std::nullopt;
-  if (!reversed_cost || (cost && *cost <= *reversed_cost)) {
-    if (!cost) return invalid;
+  if (!fit && !reversed_fit) return invalid;
+  const bool keep_first = !reversed_fit || (fit && fit->cost_per_observation <= reversed_fit->cost_per_observation);
+  // Commit only if the whole buffer prefers one structure clearly. Ceres'
+  // cost per observation is 1/2 |r|^2, i.e. the noise variance per
+  // coordinate for the right structure; the cost gap over the better fit's
+  // observations in units of that variance is a chi-square difference. A
+  // small gap means the buffer has not seen enough perspective yet: wait.
+  if (fit && reversed_fit) {
+    const Fit& best = keep_first ? *fit : *reversed_fit;
+    const Fit& other = keep_first ? *reversed_fit : *fit;
+    const double min_sigma = kMinNoisePx / options_.focal_length_px;
+    const double variance = std::max(best.cost_per_observation, min_sigma * min_sigma);
+    const double chi2_gap = 2.0 * best.observations * (other.cost_per_observation - best.cost_per_observation) / variance;
+    if (chi2_gap < options_.init_min_chi2_gap) return invalid;
+  }
+  if (keep_first) {
     poses_ = kept_poses;
     features_ = kept_features;
     window_ = kept_window;

@@ -57,8 +57,10 @@ struct ObjectTrackerOptions {
   double robust_loss_px{1.5};           // px, scale of the robust loss
   int min_init_features{20};            // common target features needed to initialise
   double min_init_parallax_deg{2.0};    // median rotation-compensated parallax to initialise
-  int init_frames{20};                  // frames the initialisation BA spans (reference to current)
-  double init_min_displacement_px{5.0}; // median image motion for a frame to join the initialisation
+  int init_frames{40};                  // consecutive frames the initialisation BA spans
+  // The initialisation commits to one of the two (Necker) structures only if
+  // the other's cost over the buffer is larger by this chi-square margin.
+  double init_min_chi2_gap{25.0};
   double ransac_threshold_px{1.5};      // px, essential matrix and PnP RANSAC
   int reference_features{5};            // features nearest the centre ray that define depth 1
   int min_track_features{10};           // fewer BA features in a frame: track lost
