@@ -39,28 +39,24 @@ double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 Eigen::Vector3d homogeneous(const Eigen::Vector2d& normalized) { return {normalized.x(), normalized.y(), 1.0}; }
 
-// Eq. 2's residual: feature l, anchored in camera a by its bearing and
-// inverse depth, projected into camera j, minus its normalized observation.
-// Both poses are T_OtoC (R_OtoC as Eigen quaternion, pbar_OinC).
-struct InverseDepthReprojection {
-  InverseDepthReprojection(const Eigen::Vector3d& bearing, const Eigen::Vector2d& observed)
-      : bearing_(bearing), observed_(observed) {}
+// Eq. 2's residual: feature l, a point in O, projected into camera j,
+// minus its normalized observation. The pose is T_OtoC (R_OtoC as Eigen
+// quaternion, pbar_OinC). Every view is a residual: a point fixed to its
+// first (anchor) ray would keep that view's noise forever.
+struct PointReprojection {
+  explicit PointReprojection(const Eigen::Vector2d& observed) : observed_(observed) {}
 
   template <typename T>
-  bool operator()(const T* q_a, const T* p_a, const T* q_j, const T* p_j, const T* inverse_depth, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_OtoCa(q_a);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pbar_OinCa(p_a);
+  bool operator()(const T* q_j, const T* p_j, const T* point, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_OtoCj(q_j);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pbar_OinCj(p_j);
-    const Eigen::Matrix<T, 3, 1> p_FinCa = bearing_.cast<T>() / inverse_depth[0];
-    const Eigen::Matrix<T, 3, 1> p_FinO = q_OtoCa.conjugate() * (p_FinCa - pbar_OinCa);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_FinO(point);
     const Eigen::Matrix<T, 3, 1> p_FinCj = q_OtoCj * p_FinO + pbar_OinCj;
     residual[0] = p_FinCj.x() / p_FinCj.z() - T(observed_.x());
     residual[1] = p_FinCj.y() / p_FinCj.z() - T(observed_.y());
     return true;
   }
 
-  Eigen::Vector3d bearing_;
   Eigen::Vector2d observed_;
 };
 
@@ -130,6 +126,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   if (o.init_frames < 2) {
     throw std::invalid_argument(s + "init_frames must be >= 2");
   }
+  if (!(o.init_min_chi2_gap >= 0.0)) throw std::invalid_argument(s + "init_min_chi2_gap must be >= 0");
   if (o.min_init_features < 8) throw std::invalid_argument(s + "min_init_features must be >= 8");
   if (o.reference_features < 1) throw std::invalid_argument(s + "reference_features must be >= 1");
   if (o.min_track_features < 4) throw std::invalid_argument(s + "min_track_features must be >= 4");
@@ -263,9 +260,7 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     poses_[ref.utime] = Pose{};
     for (const auto& [id, depth] : start_depths) {
       Feature& f = features_[id];
-      f.anchor_utime = ref.utime;
-      f.bearing = homogeneous(ref.observations.at(id));
-      f.inverse_depth = 1.0 / depth;
+      f.p_FinO = depth * homogeneous(ref.observations.at(id));  // O = C0 until the normalisation
       f.in_ba = true;
       for (const InitFrame& frame : init_frames_) {
         const auto z = frame.observations.find(id);
@@ -326,14 +321,14 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   // Fig. 5: the surface along the centre ray is at the median distance of
   // the features angularly nearest to the ray; that distance becomes 1.
   std::vector<std::pair<double, int64_t>> by_angle;
-  for (const auto& [id, f] : features_) by_angle.emplace_back(angle_between(f.bearing, ref.centre_ray), id);
+  for (const auto& [id, f] : features_) by_angle.emplace_back(angle_between(f.p_FinO, ref.centre_ray), id);
   std::sort(by_angle.begin(), by_angle.end());
   by_angle.resize(std::min(by_angle.size(), static_cast<std::size_t>(options_.reference_features)));
   std::vector<double> distances;
   std::vector<int64_t> reference_ids;
   for (const auto& [angle, id] : by_angle) {
     const Feature& f = features_.at(id);
-    distances.push_back(f.bearing.norm() / f.inverse_depth);
+    distances.push_back(f.p_FinO.norm());
     reference_ids.push_back(id);
   }
   const double d_ref = median(distances);
@@ -344,7 +339,7 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   for (auto& [utime, pose] : poses_) {
     pose.pbar_OinC = pose.q_OtoC * ref.centre_ray + pose.pbar_OinC / d_ref;
   }
-  for (auto& [id, f] : features_) f.inverse_depth *= d_ref;
+  for (auto& [id, f] : features_) f.p_FinO = f.p_FinO / d_ref - ref.centre_ray;
 
   InitFacts facts;
   facts.track_id = next_track_id_++;
@@ -400,7 +395,7 @@ ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
   for (const auto& [id, z] : obs) {
     const auto it = features_.find(id);
     if (it == features_.end() || !it->second.in_ba) continue;
-    const Eigen::Vector3d p = point_in_O(it->second);
+    const Eigen::Vector3d& p = it->second.p_FinO;
     object_points.emplace_back(p.x(), p.y(), p.z());
     image_points.emplace_back(z.x(), z.y());
   }
@@ -427,36 +422,22 @@ ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
 void ObjectTracker::add_observations(int64_t utime, const Observations& obs, const Pose& pose) {
   window_.push_back(utime);
   poses_[utime] = pose;
-  // New features start at the median depth of the current points.
-  std::vector<double> depths;
-  for (const auto& [id, z] : obs) {
-    const auto it = features_.find(id);
-    if (it == features_.end() || !it->second.in_ba) continue;
-    depths.push_back((pose.q_OtoC * point_in_O(it->second) + pose.pbar_OinC).z());
-  }
-  const double depth = depths.empty() ? 1.0 : median(depths);
-  for (const auto& [id, z] : obs) {
-    Feature& f = features_[id];
-    if (f.observations.empty()) {
-      f.anchor_utime = utime;
-      f.bearing = homogeneous(z);
-      f.inverse_depth = depth > 0.0 ? 1.0 / depth : 1.0;
-    }
-    f.observations[utime] = z;
-  }
+  for (const auto& [id, z] : obs) features_[id].observations[utime] = z;
   // A feature joins the BA once it has enough views and parallax; its
-  // inverse depth then comes from the anchor and the current view.
+  // point then comes from its oldest view in the window and the current.
   for (auto& [id, f] : features_) {
     if (f.in_ba || !obs.count(id) || static_cast<int>(f.observations.size()) < options_.min_feature_observations) {
       continue;
     }
     if (feature_parallax_rad(f) < options_.min_feature_parallax_deg * kDegToRad) continue;
-    const Pose& a = poses_.at(f.anchor_utime);
-    const Eigen::Matrix3d R_CatoC = pose.q_OtoC.toRotationMatrix() * a.q_OtoC.toRotationMatrix().transpose();
+    const auto& [first_utime, first_z] = *f.observations.begin();
+    const Pose& a = poses_.at(first_utime);
+    const Eigen::Matrix3d R_OtoCa = a.q_OtoC.toRotationMatrix();
+    const Eigen::Matrix3d R_CatoC = pose.q_OtoC.toRotationMatrix() * R_OtoCa.transpose();
     const Eigen::Vector3d p_CainC = pose.pbar_OinC - R_CatoC * a.pbar_OinC;
-    const std::optional<Eigen::Vector3d> X = triangulate(f.bearing, homogeneous(obs.at(id)), R_CatoC, p_CainC);
+    const std::optional<Eigen::Vector3d> X = triangulate(homogeneous(first_z), homogeneous(obs.at(id)), R_CatoC, p_CainC);
     if (!X) continue;
-    f.inverse_depth = 1.0 / X->z();
+    f.p_FinO = R_OtoCa.transpose() * (*X - a.pbar_OinC);
     f.in_ba = true;
   }
 }
@@ -484,28 +465,19 @@ bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
   };
   for (auto& [id, f] : features_) {
     if (!f.in_ba) continue;
-    Pose& anchor = poses_.at(f.anchor_utime);
     for (const auto& [utime, z] : f.observations) {
-      if (utime == f.anchor_utime || utime < window_.front()) continue;
       Pose& pose = poses_.at(utime);
-      add_pose(anchor);
       add_pose(pose);
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<InverseDepthReprojection, 2, 4, 3, 4, 3, 1>(
-              new InverseDepthReprojection(f.bearing, z)),
-          loss.get(), anchor.q_OtoC.coeffs().data(), anchor.pbar_OinC.data(), pose.q_OtoC.coeffs().data(),
-          pose.pbar_OinC.data(), &f.inverse_depth);
-      // A point in front of the anchor camera; also keeps 1/rho finite.
-      problem.SetParameterLowerBound(&f.inverse_depth, 0, 1e-3);
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointReprojection, 2, 4, 3, 3>(new PointReprojection(z)),
+                               loss.get(), pose.q_OtoC.coeffs().data(), pose.pbar_OinC.data(), f.p_FinO.data());
     }
-    if (f.frozen && problem.HasParameterBlock(&f.inverse_depth)) problem.SetParameterBlockConstant(&f.inverse_depth);
+    if (f.frozen && problem.HasParameterBlock(f.p_FinO.data())) problem.SetParameterBlockConstant(f.p_FinO.data());
   }
   if (problem.NumResidualBlocks() == 0) return false;
-  // Gauge: the oldest window poses and every pose outside the window.
+  // Gauge: the oldest window poses (and the frozen points).
   for (auto& [utime, pose] : poses_) {
     const auto pos = std::find(window_.begin(), window_.end(), utime);
-    const bool fixed = pos == window_.end() || pos - window_.begin() < num_fixed_poses;
-    if (fixed && problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
+    if (pos - window_.begin() < num_fixed_poses && problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
       problem.SetParameterBlockConstant(pose.q_OtoC.coeffs().data());
       problem.SetParameterBlockConstant(pose.pbar_OinC.data());
     }
@@ -538,10 +510,6 @@ int ObjectTracker::remove_outliers() {
     int rejected = 0;
     int kept = 0;
     for (auto o = f.observations.begin(); o != f.observations.end();) {
-      if (o->first == f.anchor_utime || o->first < window_.front()) {
-        ++o;
-        continue;
-      }
       if (reprojection_error_px(f, o->first, o->second) > options_.outlier_threshold_px) {
         o = f.observations.erase(o);
         ++rejected;
@@ -551,7 +519,7 @@ int ObjectTracker::remove_outliers() {
       }
     }
     removed += rejected;
-    // Most views disagree: the anchor view (the bearing) is the outlier.
+    // Most views disagree: the point itself is wrong.
     if (rejected > 0 && kept <= rejected) {
       it = features_.erase(it);
     } else {
@@ -570,12 +538,10 @@ void ObjectTracker::slide_window() {
   while (window_.size() > static_cast<std::size_t>(options_.window_size)) {
     const int64_t oldest = window_.front();
     window_.pop_front();
+    // A point seen from the leaving (fixed) pose keeps what that view told
+    // about it: it is frozen, and with the fixed poses carries the gauge.
     for (auto& [id, f] : features_) {
-      if (f.anchor_utime == oldest) {
-        f.frozen = true;
-      } else {
-        f.observations.erase(oldest);
-      }
+      if (f.observations.erase(oldest) > 0 && f.in_ba) f.frozen = true;
     }
   }
   // Feature ids are never reused after a track loss, so a candidate not seen
@@ -583,21 +549,13 @@ void ObjectTracker::slide_window() {
   for (auto it = features_.begin(); it != features_.end();) {
     const Feature& f = it->second;
     const bool seen_now = f.observations.count(current) > 0;
-    const bool in_window = f.observations.lower_bound(window_.front()) != f.observations.end();
-    const bool anchor_gone = f.anchor_utime < window_.front();
-    if ((!f.in_ba && (!seen_now || anchor_gone)) || !in_window) {
+    if ((!f.in_ba && !seen_now) || f.observations.empty()) {
       it = features_.erase(it);
     } else {
       ++it;
     }
   }
-  for (auto it = poses_.begin(); it != poses_.end();) {
-    const int64_t utime = it->first;
-    const bool needed = utime >= window_.front() ||
-                        std::any_of(features_.begin(), features_.end(),
-                                    [&](const auto& kv) { return kv.second.anchor_utime == utime; });
-    it = needed ? std::next(it) : poses_.erase(it);
-  }
+  poses_.erase(poses_.begin(), poses_.lower_bound(window_.front()));
 }
 
 bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
@@ -612,25 +570,7 @@ bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
 }
 
 void ObjectTracker::drop_frame(int64_t utime) {
-  const int64_t current = window_.back();
-  for (auto it = features_.begin(); it != features_.end();) {
-    Feature& f = it->second;
-    if (f.anchor_utime == utime) {
-      // Re-anchored in the current frame, where the point keeps its place.
-      const auto z = f.observations.find(current);
-      const Pose& pose = poses_.at(current);
-      const double depth = z == f.observations.end() ? -1.0 : (pose.q_OtoC * point_in_O(f) + pose.pbar_OinC).z();
-      if (depth <= 0.0) {
-        it = features_.erase(it);
-        continue;
-      }
-      f.anchor_utime = current;
-      f.bearing = homogeneous(z->second);
-      f.inverse_depth = 1.0 / depth;
-    }
-    f.observations.erase(utime);
-    ++it;
-  }
+  for (auto& [id, f] : features_) f.observations.erase(utime);
   window_.erase(std::find(window_.begin(), window_.end(), utime));
   poses_.erase(utime);
 }
@@ -643,21 +583,17 @@ void ObjectTracker::reset() {
   init_frames_.clear();
 }
 
-Eigen::Vector3d ObjectTracker::point_in_O(const Feature& f) const {
-  const Pose& a = poses_.at(f.anchor_utime);
-  return a.q_OtoC.conjugate() * (f.bearing / f.inverse_depth - a.pbar_OinC);
-}
-
 double ObjectTracker::feature_parallax_rad(const Feature& f) const {
-  const auto& [utime, z] = *f.observations.rbegin();
+  const auto& [first_utime, first_z] = *f.observations.begin();
+  const auto& [last_utime, last_z] = *f.observations.rbegin();
   const Eigen::Matrix3d R_CtoCa =
-      poses_.at(f.anchor_utime).q_OtoC.toRotationMatrix() * poses_.at(utime).q_OtoC.toRotationMatrix().transpose();
-  return angle_between(f.bearing, R_CtoCa * homogeneous(z));
+      poses_.at(first_utime).q_OtoC.toRotationMatrix() * poses_.at(last_utime).q_OtoC.toRotationMatrix().transpose();
+  return angle_between(homogeneous(first_z), R_CtoCa * homogeneous(last_z));
 }
 
 double ObjectTracker::reprojection_error_px(const Feature& f, int64_t utime, const Eigen::Vector2d& z) const {
   const Pose& pose = poses_.at(utime);
-  const Eigen::Vector3d p_FinC = pose.q_OtoC * point_in_O(f) + pose.pbar_OinC;
+  const Eigen::Vector3d p_FinC = pose.q_OtoC * f.p_FinO + pose.pbar_OinC;
   if (!(p_FinC.z() > 0.0)) return std::numeric_limits<double>::infinity();
   return (p_FinC.head<2>() / p_FinC.z() - z).norm() * options_.focal_length_px;
 }
@@ -671,7 +607,7 @@ ObjectPoseEstimate ObjectTracker::make_estimate(int64_t utime, const Observation
   for (const auto& [id, z] : obs) {
     const auto it = features_.find(id);
     if (it == features_.end() || !it->second.in_ba || !it->second.observations.count(utime)) continue;
-    const double err = utime == it->second.anchor_utime ? 0.0 : reprojection_error_px(it->second, utime, z);
+    const double err = reprojection_error_px(it->second, utime, z);
     sum_sq += err * err;
     ++e.num_features;
   }

@@ -20,16 +20,17 @@
 // |p_FinC| at reference_utime (see InitFacts).
 //
 // Scale consistency: the two oldest window poses are held constant, and a
-// feature whose anchor frame has left the window is frozen (anchor pose and
-// inverse depth constant); those frozen points carry the gauge forward. The
+// point (3D, in O) seen from a pose that has left the window is frozen;
+// those frozen points carry the gauge forward. The
 // window keeps keyframes (the newest-but-one frame is dropped unless it
 // moved enough), so its N frames span more motion than N consecutive ones.
 //
-// Initialisation: frames join a buffer once the image moved; with
-// `init_frames` buffered, a two-view (essential matrix) between the first
-// and the last gives depths, the frames in between are posed by PnP and all
-// go through a BA. A small object projects almost affinely, so the
-// depth-reversed structure is solved too and the cheaper kept.
+// Initialisation: every frame joins a buffer; with `init_frames` buffered,
+// a two-view (essential matrix) between the first and the last gives
+// depths, the frames in between are posed by PnP and all go through a BA. A
+// small object projects almost affinely, so the depth-reversed structure is
+// solved too; the tracker commits only if one is clearly cheaper
+// (`init_min_chi2_gap`), else the buffer slides on.
 //
 // Internally poses are Ceres parameter blocks (Eigen::Quaterniond, whose
 // coefficient order x y z w is what EigenQuaternionManifold expects); they
@@ -126,12 +127,10 @@ class ObjectTracker {
     Eigen::Vector3d pbar_OinC{Eigen::Vector3d::Zero()};
   };
   struct Feature {
-    int64_t anchor_utime{0};
-    Eigen::Vector3d bearing{Eigen::Vector3d::UnitZ()};  // [x y 1] in the anchor camera
-    double inverse_depth{1.0};                          // 1 / z in the anchor camera
-    std::map<int64_t, Eigen::Vector2d> observations;    // utime -> normalized (anchor included)
+    Eigen::Vector3d p_FinO{Eigen::Vector3d::Zero()};  // tracker units; set when it joins the BA
+    std::map<int64_t, Eigen::Vector2d> observations;  // window utime -> normalized
     bool in_ba{false};
-    bool frozen{false};  // anchor left the window: point constant
+    bool frozen{false};  // seen from a pose that left the window: point constant
   };
   using Observations = std::map<int64_t, Eigen::Vector2d>;  // feature id -> normalized
   struct InitFrame {
@@ -150,7 +149,6 @@ class ObjectTracker {
   bool is_keyframe(int64_t utime, int64_t previous_utime) const;
   void drop_frame(int64_t utime);
   void reset();
-  Eigen::Vector3d point_in_O(const Feature& f) const;
   double feature_parallax_rad(const Feature& f) const;
   double reprojection_error_px(const Feature& f, int64_t utime, const Eigen::Vector2d& z) const;
   ObjectPoseEstimate make_estimate(int64_t utime, const Observations& obs) const;
@@ -170,7 +168,7 @@ class ObjectTracker {
 
   // Tracking state.
   std::deque<int64_t> window_;    // utimes, oldest first
-  std::map<int64_t, Pose> poses_; // window poses and anchors of frozen features
+  std::map<int64_t, Pose> poses_; // window poses
   std::map<int64_t, Feature> features_;
 };
 
