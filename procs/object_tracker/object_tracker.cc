@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 #include <ceres/ceres.h>
@@ -118,6 +119,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.max_iterations = config.get_or<int>(s + "max_iterations", o.max_iterations);
   o.keyframe_rotation_deg = config.get_or<double>(s + "keyframe_rotation_deg", o.keyframe_rotation_deg);
   o.keyframe_baseline = config.get_or<double>(s + "keyframe_baseline", o.keyframe_baseline);
+  o.reassociation_px = config.get_or<double>(s + "reassociation_px", o.reassociation_px);
   if (o.window_size < 3) throw std::invalid_argument(s + "window_size must be >= 3");
   if (!(o.focal_length_px > 0.0)) throw std::invalid_argument(s + "focal_length_px must be > 0");
   if (o.robust_loss != "huber" && o.robust_loss != "cauchy") {
@@ -126,6 +128,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   if (o.init_frames < 2) {
     throw std::invalid_argument(s + "init_frames must be >= 2");
   }
+  if (!(o.reassociation_px >= 0.0)) throw std::invalid_argument(s + "reassociation_px must be >= 0");
   if (!(o.init_min_chi2_gap >= 0.0)) throw std::invalid_argument(s + "init_min_chi2_gap must be >= 0");
   if (o.min_init_features < 8) throw std::invalid_argument(s + "min_init_features must be >= 8");
   if (o.reference_features < 1) throw std::invalid_argument(s + "reference_features must be >= 1");
@@ -355,7 +358,7 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   return estimate;
 }
 
-ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) {
+ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& raw_obs) {
   ObjectPoseEstimate invalid;
   invalid.utime = utime;
   const auto lose_track = [&] {
@@ -363,6 +366,8 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
     reset();
     return invalid;
   };
+  const Pose predicted = predict_pose(with_aliases(raw_obs));
+  const Observations obs = associate(raw_obs, predicted);
   int tracked = 0;
   for (const auto& [id, z] : obs) {
     const auto it = features_.find(id);
@@ -371,7 +376,7 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
   if (tracked < options_.min_track_features) return lose_track();
 
   const auto t0 = std::chrono::steady_clock::now();
-  add_observations(utime, obs, predict_pose(obs));
+  add_observations(utime, obs, predicted);
   bool solved = solve_window(2, options_.max_iterations);
   // The second removal catches what the re-solve pushed out (e.g. a new
   // point behind a camera); it changes no estimate, so no third solve.
@@ -386,6 +391,54 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
   if (!estimate.valid) return lose_track();
   slide_window();
   return estimate;
+}
+
+ObjectTracker::Observations ObjectTracker::with_aliases(const Observations& obs) const {
+  Observations out;
+  for (const auto& [id, z] : obs) {
+    const auto alias = aliases_.find(id);
+    out[alias == aliases_.end() ? id : alias->second] = z;
+  }
+  return out;
+}
+
+ObjectTracker::Observations ObjectTracker::associate(const Observations& raw_obs, const Pose& pose) {
+  Observations obs = with_aliases(raw_obs);
+  // A front end gives a point a fresh id when its track breaks, though it
+  // is the same surface point. A new id whose observation falls on the
+  // projection of exactly one BA point not seen in this frame continues
+  // that point: the points then live as long as they are visible, and the
+  // structure (and with it the gauge and scale) is not handed over from
+  // one short-lived generation of points to the next.
+  const double gate = options_.reassociation_px / options_.focal_length_px;
+  std::vector<std::pair<int64_t, Eigen::Vector2d>> lost;
+  for (const auto& [id, f] : features_) {
+    if (!f.in_ba || obs.count(id)) continue;
+    const Eigen::Vector3d p_FinC = pose.q_OtoC * f.p_FinO + pose.pbar_OinC;
+    if (p_FinC.z() > 0.0) lost.emplace_back(id, p_FinC.head<2>() / p_FinC.z());
+  }
+  for (const auto& [raw_id, z] : raw_obs) {
+    if (aliases_.count(raw_id) || features_.count(raw_id)) continue;
+    double best = std::numeric_limits<double>::infinity();
+    double second = best;
+    int64_t best_id = -1;
+    for (const auto& [id, projection] : lost) {
+      const double d = (projection - z).norm();
+      if (d < best) {
+        second = best;
+        best = d;
+        best_id = id;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    // Unambiguous: no other point within twice the gate.
+    if (best > gate || second < 2.0 * gate || obs.count(best_id)) continue;
+    aliases_[raw_id] = best_id; fprintf(stderr, "ALIAS\n");
+    obs.erase(raw_id);
+    obs[best_id] = z;
+  }
+  return obs;
 }
 
 ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
@@ -471,13 +524,13 @@ bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointReprojection, 2, 4, 3, 3>(new PointReprojection(z)),
                                loss.get(), pose.q_OtoC.coeffs().data(), pose.pbar_OinC.data(), f.p_FinO.data());
     }
-    if (f.frozen && problem.HasParameterBlock(f.p_FinO.data())) problem.SetParameterBlockConstant(f.p_FinO.data());
   }
   if (problem.NumResidualBlocks() == 0) return false;
-  // Gauge: the oldest window poses (and the frozen points).
+  // Gauge: the oldest window poses and the retired ones.
   for (auto& [utime, pose] : poses_) {
     const auto pos = std::find(window_.begin(), window_.end(), utime);
-    if (pos - window_.begin() < num_fixed_poses && problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
+    if ((pos == window_.end() || pos - window_.begin() < num_fixed_poses) &&
+        problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
       problem.SetParameterBlockConstant(pose.q_OtoC.coeffs().data());
       problem.SetParameterBlockConstant(pose.pbar_OinC.data());
     }
@@ -538,24 +591,29 @@ void ObjectTracker::slide_window() {
   while (window_.size() > static_cast<std::size_t>(options_.window_size)) {
     const int64_t oldest = window_.front();
     window_.pop_front();
-    // A point seen from the leaving (fixed) pose keeps what that view told
-    // about it: it is frozen, and with the fixed poses carries the gauge.
+    // The leaving pose is retired, not forgotten: it stays (constant) with
+    // its views of the BA points while they live, so those views keep
+    // constraining the points and, through them, carry the gauge. Freezing
+    // the points instead would keep their early (e.g. the initialisation's)
+    // errors for good.
     for (auto& [id, f] : features_) {
-      if (f.observations.erase(oldest) > 0 && f.in_ba) f.frozen = true;
+      if (!f.in_ba) f.observations.erase(oldest);
     }
   }
   // Feature ids are never reused after a track loss, so a candidate not seen
   // now can never join, and a BA feature without views in the window is gone.
+  std::set<int64_t> referenced(window_.begin(), window_.end());
   for (auto it = features_.begin(); it != features_.end();) {
     const Feature& f = it->second;
     const bool seen_now = f.observations.count(current) > 0;
-    if ((!f.in_ba && !seen_now) || f.observations.empty()) {
+    if ((!f.in_ba && !seen_now) || f.observations.lower_bound(window_.front()) == f.observations.end()) {
       it = features_.erase(it);
     } else {
+      for (const auto& [utime, z] : f.observations) referenced.insert(utime);
       ++it;
     }
   }
-  poses_.erase(poses_.begin(), poses_.lower_bound(window_.front()));
+  for (auto it = poses_.begin(); it != poses_.end();) it = referenced.count(it->first) ? std::next(it) : poses_.erase(it);
 }
 
 bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
@@ -580,6 +638,7 @@ void ObjectTracker::reset() {
   window_.clear();
   poses_.clear();
   features_.clear();
+  aliases_.clear();
   init_frames_.clear();
 }
 

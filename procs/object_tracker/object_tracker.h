@@ -20,8 +20,8 @@
 // |p_FinC| at reference_utime (see InitFacts).
 //
 // Scale consistency: the two oldest window poses are held constant, and a
-// point (3D, in O) seen from a pose that has left the window is frozen;
-// those frozen points carry the gauge forward. The
+// pose that leaves the window is retired: constant, its views of the
+// points (3D, in O) kept while those live; they carry the gauge forward. The
 // window keeps keyframes (the newest-but-one frame is dropped unless it
 // moved enough), so its N frames span more motion than N consecutive ones.
 //
@@ -75,6 +75,10 @@ struct ObjectTrackerOptions {
   // more relative motion than N consecutive frames.
   double keyframe_rotation_deg{3.0};
   double keyframe_baseline{0.05};       // tracker units (1 = the initial object distance)
+  // A new feature id observed within this distance of the projection of
+  // one BA point not seen in the frame (and no other within twice it) is
+  // that point again (a broken track of the front end).
+  double reassociation_px{4.0};
 };
 
 /// Reads the `object_tracker:` section (every key optional, defaults above).
@@ -128,9 +132,8 @@ class ObjectTracker {
   };
   struct Feature {
     Eigen::Vector3d p_FinO{Eigen::Vector3d::Zero()};  // tracker units; set when it joins the BA
-    std::map<int64_t, Eigen::Vector2d> observations;  // window utime -> normalized
+    std::map<int64_t, Eigen::Vector2d> observations;  // utime (window or retired pose) -> normalized
     bool in_ba{false};
-    bool frozen{false};  // seen from a pose that left the window: point constant
   };
   using Observations = std::map<int64_t, Eigen::Vector2d>;  // feature id -> normalized
   struct InitFrame {
@@ -140,7 +143,9 @@ class ObjectTracker {
   };
 
   ObjectPoseEstimate try_initialise(InitFrame frame);
-  ObjectPoseEstimate track(int64_t utime, const Observations& obs);
+  ObjectPoseEstimate track(int64_t utime, const Observations& raw_obs);
+  Observations with_aliases(const Observations& obs) const;
+  Observations associate(const Observations& raw_obs, const Pose& pose);
   Pose predict_pose(const Observations& obs) const;
   void add_observations(int64_t utime, const Observations& obs, const Pose& pose);
   bool solve_window(int num_fixed_poses, int max_iterations);
@@ -168,8 +173,9 @@ class ObjectTracker {
 
   // Tracking state.
   std::deque<int64_t> window_;    // utimes, oldest first
-  std::map<int64_t, Pose> poses_; // window poses
+  std::map<int64_t, Pose> poses_; // window and retired poses
   std::map<int64_t, Feature> features_;
+  std::map<int64_t, int64_t> aliases_;  // front-end feature id -> the feature it continues
 };
 
 }  // namespace vimot
