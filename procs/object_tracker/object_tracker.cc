@@ -491,7 +491,12 @@ void ObjectTracker::add_observations(int64_t utime, const Observations& obs, con
     const std::optional<Eigen::Vector3d> X = triangulate(homogeneous(first_z), homogeneous(obs.at(id)), R_CatoC, p_CainC);
     if (!X) continue;
     f.p_FinO = R_OtoCa.transpose() * (*X - a.pbar_OinC);
-    f.in_ba = true;
+    // Only a point that fits all its views joins: a wrong one (a mismatch,
+    // or a two-view depth off in a bad geometry) would pull the poses before
+    // the outlier removal sees it, and take good points with it.
+    f.in_ba = std::all_of(f.observations.begin(), f.observations.end(), [&](const auto& o) {
+      return reprojection_error_px(f, o.first, o.second) <= options_.outlier_threshold_px;
+    });
   }
 }
 
