@@ -434,7 +434,7 @@ ObjectTracker::Observations ObjectTracker::associate(const Observations& raw_obs
     }
     // Unambiguous: no other point within twice the gate.
     if (best > gate || second < 2.0 * gate || obs.count(best_id)) continue;
-    aliases_[raw_id] = best_id; fprintf(stderr, "ALIAS\n");
+    aliases_[raw_id] = best_id;
     obs.erase(raw_id);
     obs[best_id] = z;
   }
