@@ -249,13 +249,10 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   // A BA over all buffered frames from these depths, the frames after the
   // reference posed by PnP in turn: a small object spans a narrow field of
   // view, where two views hardly separate rotation from translation.
-  // Returns the cost per observation after the outlier removal (the two
-  // hypotheses may keep different observations); the state is left in the
+  // Returns the squared reprojection errors (normalized units) of the
+  // observations its outlier removal kept; the state is left in the
   // members.
-  struct Fit {
-    double cost_per_observation;
-    int observations;
-  };
+  using Fit = std::map<std::pair<int64_t, int64_t>, double>;  // (feature, utime) -> |r|^2
   const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<Fit> {
     poses_.clear();
     features_.clear();
@@ -279,7 +276,14 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     // the normalisation below.
     if (!solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
     if (remove_outliers() > 0 && !solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
-    return Fit{last_cost_ / std::max(last_num_residuals_, 1), last_num_residuals_};
+    Fit fit;
+    for (const auto& [id, f] : features_) {
+      for (const auto& [utime, z] : f.observations) {
+        const double e = reprojection_error_px(f, utime, z) / options_.focal_length_px;
+        fit[{id, utime}] = e * e;
+      }
+    }
+    return fit;
   };
   // Under the near-affine projection of a small object the depth-reversed
   // structure (Necker reversal: depths mirrored about their median) fits
@@ -300,19 +304,27 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   const std::optional<Fit> reversed_fit =
       static_cast<int>(reversed.size()) >= options_.min_init_features ? solve_from(reversed) : std::nullopt;
   if (!fit && !reversed_fit) return invalid;
-  const bool keep_first = !reversed_fit || (fit && fit->cost_per_observation <= reversed_fit->cost_per_observation);
-  // Commit only if the whole buffer prefers one structure clearly. Ceres'
-  // cost per observation is 1/2 |r|^2, i.e. the noise variance per
-  // coordinate for the right structure; the cost gap over the better fit's
-  // observations in units of that variance is a chi-square difference. A
-  // small gap means the buffer has not seen enough perspective yet: wait.
+  // Commit only if the whole buffer prefers one structure clearly: the sum
+  // of squared errors over the observations both kept (each hypothesis'
+  // outlier removal alone would favour the one that discarded the views it
+  // fits worst), in units of the noise variance per coordinate estimated
+  // from the better one, is a chi-square difference. A small gap means the
+  // buffer has not seen enough perspective yet: wait.
+  bool keep_first = !reversed_fit;
   if (fit && reversed_fit) {
-    const Fit& best = keep_first ? *fit : *reversed_fit;
-    const Fit& other = keep_first ? *reversed_fit : *fit;
+    double sum_first = 0.0, sum_reversed = 0.0;
+    int common = 0;
+    for (const auto& [key, e2] : *fit) {
+      const auto other = reversed_fit->find(key);
+      if (other == reversed_fit->end()) continue;
+      sum_first += e2;
+      sum_reversed += other->second;
+      ++common;
+    }
+    keep_first = sum_first <= sum_reversed;
     const double min_sigma = kMinNoisePx / options_.focal_length_px;
-    const double variance = std::max(best.cost_per_observation, min_sigma * min_sigma);
-    const double chi2_gap = 2.0 * best.observations * (other.cost_per_observation - best.cost_per_observation) / variance;
-    if (chi2_gap < options_.init_min_chi2_gap) return invalid;
+    const double variance = std::max(std::min(sum_first, sum_reversed) / std::max(2 * common, 1), min_sigma * min_sigma);
+    if (std::abs(sum_first - sum_reversed) / variance < options_.init_min_chi2_gap) return invalid;
   }
   if (keep_first) {
     poses_ = kept_poses;
@@ -548,8 +560,6 @@ bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   if (!summary.IsSolutionUsable()) return false;
-  last_cost_ = summary.final_cost;
-  last_num_residuals_ = problem.NumResidualBlocks();
   for (auto& [utime, pose] : poses_) {
     if (!pose.q_OtoC.coeffs().allFinite() || !pose.pbar_OinC.allFinite()) return false;
     pose.q_OtoC.normalize();

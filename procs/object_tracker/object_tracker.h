@@ -164,8 +164,6 @@ class ObjectTracker {
   int64_t next_track_id_{1};
   std::optional<InitFacts> init_facts_;
   double last_solve_seconds_{0.0};
-  double last_cost_{0.0};      // final cost of the last solve_window()
-  int last_num_residuals_{0};  // its number of observations
 
   bool tracking_{false};
   // Initialisation buffer: frames since the reference frame.

@@ -201,7 +201,8 @@ TEST_CASE("a 1 s gap without target observations gives a new track, accurate aga
 
 // 20 px is far outside the 1 px noise: RANSAC (1.5 px), the outlier removal
 // (3 px) and the check of a joining point (3 px) see every such view, so the
-// bounds are those of the 1 px case.
+// bounds are those of the 1 px case. (Open: over 60 s such runs still lose
+// the track when a new face comes into view; docs/object_tracker.md.)
 TEST_CASE("5 % of the target observations 20 px off: the robust BA stays accurate", "[object_tracker]") {
   ObjectTracker tracker;
   std::mt19937 rng(7);
