@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 #include <ceres/ceres.h>
@@ -22,6 +23,9 @@ constexpr double kDegToRad = M_PI / 180.0;
 // The initialisation starts from a two-view guess, far from the optimum
 // compared with a tracked frame's PnP pose: it gets more iterations.
 constexpr int kInitIterationFactor = 5;
+// Floor of the pixel noise in the initialisation's hypothesis test, so that
+// noise-free input gives a finite chi-square gap.
+constexpr double kMinNoisePx = 0.01;
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -36,28 +40,24 @@ double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 Eigen::Vector3d homogeneous(const Eigen::Vector2d& normalized) { return {normalized.x(), normalized.y(), 1.0}; }
 
-// Eq. 2's residual: feature l, anchored in camera a by its bearing and
-// inverse depth, projected into camera j, minus its normalized observation.
-// Both poses are T_OtoC (R_OtoC as Eigen quaternion, pbar_OinC).
-struct InverseDepthReprojection {
-  InverseDepthReprojection(const Eigen::Vector3d& bearing, const Eigen::Vector2d& observed)
-      : bearing_(bearing), observed_(observed) {}
+// Eq. 2's residual: feature l, a point in O, projected into camera j,
+// minus its normalized observation. The pose is T_OtoC (R_OtoC as Eigen
+// quaternion, pbar_OinC). Every view is a residual: a point fixed to its
+// first (anchor) ray would keep that view's noise forever.
+struct PointReprojection {
+  explicit PointReprojection(const Eigen::Vector2d& observed) : observed_(observed) {}
 
   template <typename T>
-  bool operator()(const T* q_a, const T* p_a, const T* q_j, const T* p_j, const T* inverse_depth, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_OtoCa(q_a);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pbar_OinCa(p_a);
+  bool operator()(const T* q_j, const T* p_j, const T* point, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_OtoCj(q_j);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pbar_OinCj(p_j);
-    const Eigen::Matrix<T, 3, 1> p_FinCa = bearing_.cast<T>() / inverse_depth[0];
-    const Eigen::Matrix<T, 3, 1> p_FinO = q_OtoCa.conjugate() * (p_FinCa - pbar_OinCa);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_FinO(point);
     const Eigen::Matrix<T, 3, 1> p_FinCj = q_OtoCj * p_FinO + pbar_OinCj;
     residual[0] = p_FinCj.x() / p_FinCj.z() - T(observed_.x());
     residual[1] = p_FinCj.y() / p_FinCj.z() - T(observed_.y());
     return true;
   }
 
-  Eigen::Vector3d bearing_;
   Eigen::Vector2d observed_;
 };
 
@@ -108,7 +108,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.min_init_features = config.get_or<int>(s + "min_init_features", o.min_init_features);
   o.min_init_parallax_deg = config.get_or<double>(s + "min_init_parallax_deg", o.min_init_parallax_deg);
   o.init_frames = config.get_or<int>(s + "init_frames", o.init_frames);
-  o.init_min_displacement_px = config.get_or<double>(s + "init_min_displacement_px", o.init_min_displacement_px);
+  o.init_min_chi2_gap = config.get_or<double>(s + "init_min_chi2_gap", o.init_min_chi2_gap);
   o.ransac_threshold_px = config.get_or<double>(s + "ransac_threshold_px", o.ransac_threshold_px);
   o.reference_features = config.get_or<int>(s + "reference_features", o.reference_features);
   o.min_track_features = config.get_or<int>(s + "min_track_features", o.min_track_features);
@@ -119,14 +119,17 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.max_iterations = config.get_or<int>(s + "max_iterations", o.max_iterations);
   o.keyframe_rotation_deg = config.get_or<double>(s + "keyframe_rotation_deg", o.keyframe_rotation_deg);
   o.keyframe_baseline = config.get_or<double>(s + "keyframe_baseline", o.keyframe_baseline);
+  o.reassociation_px = config.get_or<double>(s + "reassociation_px", o.reassociation_px);
   if (o.window_size < 3) throw std::invalid_argument(s + "window_size must be >= 3");
   if (!(o.focal_length_px > 0.0)) throw std::invalid_argument(s + "focal_length_px must be > 0");
   if (o.robust_loss != "huber" && o.robust_loss != "cauchy") {
     throw std::invalid_argument(s + "robust_loss must be huber or cauchy, got " + o.robust_loss);
   }
-  if (o.init_frames < 2 || o.init_frames > o.window_size) {
-    throw std::invalid_argument(s + "init_frames must be in [2, window_size]");
+  if (o.init_frames < 2) {
+    throw std::invalid_argument(s + "init_frames must be >= 2");
   }
+  if (!(o.reassociation_px >= 0.0)) throw std::invalid_argument(s + "reassociation_px must be >= 0");
+  if (!(o.init_min_chi2_gap >= 0.0)) throw std::invalid_argument(s + "init_min_chi2_gap must be >= 0");
   if (o.min_init_features < 8) throw std::invalid_argument(s + "min_init_features must be >= 8");
   if (o.reference_features < 1) throw std::invalid_argument(s + "reference_features must be >= 1");
   if (o.min_track_features < 4) throw std::invalid_argument(s + "min_track_features must be >= 4");
@@ -184,23 +187,11 @@ ObjectPoseEstimate ObjectTracker::process(const CameraFrame& frame, const std::o
 ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   ObjectPoseEstimate invalid;
   invalid.utime = frame.utime;
-  // Frames join the buffer once the image has moved: the buffer then spans
-  // enough relative motion to tell rotation from translation (see below).
-  if (!init_frames_.empty()) {
-    std::vector<double> displacement;
-    for (const auto& [id, z] : frame.observations) {
-      const auto last = init_frames_.back().observations.find(id);
-      if (last != init_frames_.back().observations.end()) displacement.push_back((z - last->second).norm());
-    }
-    if (static_cast<int>(displacement.size()) >= options_.min_init_features &&
-        median(displacement) * options_.focal_length_px < options_.init_min_displacement_px) {
-      return invalid;
-    }
-  }
+  // Every frame is buffered: with the camera looking at the object, the
+  // target hardly moves in the image, yet its view direction changes, and
+  // that rotation is what resolves the structure of a small object.
   init_frames_.push_back(std::move(frame));
-  // The reference must share enough features with the current frame and
-  // stay within one window of it; otherwise the next frame becomes it.
-  while (init_frames_.size() > static_cast<std::size_t>(options_.window_size)) init_frames_.pop_front();
+  while (init_frames_.size() > static_cast<std::size_t>(options_.init_frames)) init_frames_.pop_front();
   const InitFrame& cur = init_frames_.back();
   std::vector<int64_t> ids;
   while (init_frames_.size() >= 2) {
@@ -258,19 +249,18 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   // A BA over all buffered frames from these depths, the frames after the
   // reference posed by PnP in turn: a small object spans a narrow field of
   // view, where two views hardly separate rotation from translation.
-  // Returns the cost per observation after the outlier removal (the two
-  // hypotheses may keep different observations); the state is left in the
+  // Returns the squared reprojection errors (normalized units) of the
+  // observations its outlier removal kept; the state is left in the
   // members.
-  const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<double> {
+  using Fit = std::map<std::pair<int64_t, int64_t>, double>;  // (feature, utime) -> |r|^2
+  const auto solve_from = [&](const std::map<int64_t, double>& start_depths) -> std::optional<Fit> {
     poses_.clear();
     features_.clear();
     window_ = {ref.utime};
     poses_[ref.utime] = Pose{};
     for (const auto& [id, depth] : start_depths) {
       Feature& f = features_[id];
-      f.anchor_utime = ref.utime;
-      f.bearing = homogeneous(ref.observations.at(id));
-      f.inverse_depth = 1.0 / depth;
+      f.p_FinO = depth * homogeneous(ref.observations.at(id));  // O = C0 until the normalisation
       f.in_ba = true;
       for (const InitFrame& frame : init_frames_) {
         const auto z = frame.observations.find(id);
@@ -286,13 +276,20 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     // the normalisation below.
     if (!solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
     if (remove_outliers() > 0 && !solve_window(1, kInitIterationFactor * options_.max_iterations)) return std::nullopt;
-    return last_cost_ / std::max(last_num_residuals_, 1);
+    Fit fit;
+    for (const auto& [id, f] : features_) {
+      for (const auto& [utime, z] : f.observations) {
+        const double e = reprojection_error_px(f, utime, z) / options_.focal_length_px;
+        fit[{id, utime}] = e * e;
+      }
+    }
+    return fit;
   };
   // Under the near-affine projection of a small object the depth-reversed
   // structure (Necker reversal: depths mirrored about their median) fits
   // almost as well and the BA cannot leave it; both are solved and the
   // cheaper kept.
-  const std::optional<double> cost = solve_from(depths);
+  const std::optional<Fit> fit = solve_from(depths);
   const auto kept_poses = poses_;
   const auto kept_features = features_;
   const auto kept_window = window_;
@@ -304,10 +301,32 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     const double mirrored = 2.0 * median_depth - depth;
     if (mirrored > 0.0) reversed[id] = mirrored;
   }
-  const std::optional<double> reversed_cost =
+  const std::optional<Fit> reversed_fit =
       static_cast<int>(reversed.size()) >= options_.min_init_features ? solve_from(reversed) : std::nullopt;
-  if (!reversed_cost || (cost && *cost <= *reversed_cost)) {
-    if (!cost) return invalid;
+  if (!fit && !reversed_fit) return invalid;
+  // Commit only if the whole buffer prefers one structure clearly: the sum
+  // of squared errors over the observations both kept (each hypothesis'
+  // outlier removal alone would favour the one that discarded the views it
+  // fits worst), in units of the noise variance per coordinate estimated
+  // from the better one, is a chi-square difference. A small gap means the
+  // buffer has not seen enough perspective yet: wait.
+  bool keep_first = !reversed_fit;
+  if (fit && reversed_fit) {
+    double sum_first = 0.0, sum_reversed = 0.0;
+    int common = 0;
+    for (const auto& [key, e2] : *fit) {
+      const auto other = reversed_fit->find(key);
+      if (other == reversed_fit->end()) continue;
+      sum_first += e2;
+      sum_reversed += other->second;
+      ++common;
+    }
+    keep_first = sum_first <= sum_reversed;
+    const double min_sigma = kMinNoisePx / options_.focal_length_px;
+    const double variance = std::max(std::min(sum_first, sum_reversed) / std::max(2 * common, 1), min_sigma * min_sigma);
+    if (std::abs(sum_first - sum_reversed) / variance < options_.init_min_chi2_gap) return invalid;
+  }
+  if (keep_first) {
     poses_ = kept_poses;
     features_ = kept_features;
     window_ = kept_window;
@@ -317,14 +336,14 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   // Fig. 5: the surface along the centre ray is at the median distance of
   // the features angularly nearest to the ray; that distance becomes 1.
   std::vector<std::pair<double, int64_t>> by_angle;
-  for (const auto& [id, f] : features_) by_angle.emplace_back(angle_between(f.bearing, ref.centre_ray), id);
+  for (const auto& [id, f] : features_) by_angle.emplace_back(angle_between(f.p_FinO, ref.centre_ray), id);
   std::sort(by_angle.begin(), by_angle.end());
   by_angle.resize(std::min(by_angle.size(), static_cast<std::size_t>(options_.reference_features)));
   std::vector<double> distances;
   std::vector<int64_t> reference_ids;
   for (const auto& [angle, id] : by_angle) {
     const Feature& f = features_.at(id);
-    distances.push_back(f.bearing.norm() / f.inverse_depth);
+    distances.push_back(f.p_FinO.norm());
     reference_ids.push_back(id);
   }
   const double d_ref = median(distances);
@@ -335,7 +354,7 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   for (auto& [utime, pose] : poses_) {
     pose.pbar_OinC = pose.q_OtoC * ref.centre_ray + pose.pbar_OinC / d_ref;
   }
-  for (auto& [id, f] : features_) f.inverse_depth *= d_ref;
+  for (auto& [id, f] : features_) f.p_FinO = f.p_FinO / d_ref - ref.centre_ray;
 
   InitFacts facts;
   facts.track_id = next_track_id_++;
@@ -351,7 +370,7 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
   return estimate;
 }
 
-ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) {
+ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& raw_obs) {
   ObjectPoseEstimate invalid;
   invalid.utime = utime;
   const auto lose_track = [&] {
@@ -359,6 +378,8 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
     reset();
     return invalid;
   };
+  const Pose predicted = predict_pose(with_aliases(raw_obs));
+  const Observations obs = associate(raw_obs, predicted);
   int tracked = 0;
   for (const auto& [id, z] : obs) {
     const auto it = features_.find(id);
@@ -367,7 +388,7 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
   if (tracked < options_.min_track_features) return lose_track();
 
   const auto t0 = std::chrono::steady_clock::now();
-  add_observations(utime, obs, predict_pose(obs));
+  add_observations(utime, obs, predicted);
   bool solved = solve_window(2, options_.max_iterations);
   // The second removal catches what the re-solve pushed out (e.g. a new
   // point behind a camera); it changes no estimate, so no third solve.
@@ -384,6 +405,54 @@ ObjectPoseEstimate ObjectTracker::track(int64_t utime, const Observations& obs) 
   return estimate;
 }
 
+ObjectTracker::Observations ObjectTracker::with_aliases(const Observations& obs) const {
+  Observations out;
+  for (const auto& [id, z] : obs) {
+    const auto alias = aliases_.find(id);
+    out[alias == aliases_.end() ? id : alias->second] = z;
+  }
+  return out;
+}
+
+ObjectTracker::Observations ObjectTracker::associate(const Observations& raw_obs, const Pose& pose) {
+  Observations obs = with_aliases(raw_obs);
+  // A front end gives a point a fresh id when its track breaks, though it
+  // is the same surface point. A new id whose observation falls on the
+  // projection of exactly one BA point not seen in this frame continues
+  // that point: the points then live as long as they are visible, and the
+  // structure (and with it the gauge and scale) is not handed over from
+  // one short-lived generation of points to the next.
+  const double gate = options_.reassociation_px / options_.focal_length_px;
+  std::vector<std::pair<int64_t, Eigen::Vector2d>> lost;
+  for (const auto& [id, f] : features_) {
+    if (!f.in_ba || obs.count(id)) continue;
+    const Eigen::Vector3d p_FinC = pose.q_OtoC * f.p_FinO + pose.pbar_OinC;
+    if (p_FinC.z() > 0.0) lost.emplace_back(id, p_FinC.head<2>() / p_FinC.z());
+  }
+  for (const auto& [raw_id, z] : raw_obs) {
+    if (aliases_.count(raw_id) || features_.count(raw_id)) continue;
+    double best = std::numeric_limits<double>::infinity();
+    double second = best;
+    int64_t best_id = -1;
+    for (const auto& [id, projection] : lost) {
+      const double d = (projection - z).norm();
+      if (d < best) {
+        second = best;
+        best = d;
+        best_id = id;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    // Unambiguous: no other point within twice the gate.
+    if (best > gate || second < 2.0 * gate || obs.count(best_id)) continue;
+    aliases_[raw_id] = best_id;
+    obs.erase(raw_id);
+    obs[best_id] = z;
+  }
+  return obs;
+}
+
 ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
   const Pose& last = poses_.at(window_.back());
   std::vector<cv::Point3d> object_points;
@@ -391,7 +460,7 @@ ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
   for (const auto& [id, z] : obs) {
     const auto it = features_.find(id);
     if (it == features_.end() || !it->second.in_ba) continue;
-    const Eigen::Vector3d p = point_in_O(it->second);
+    const Eigen::Vector3d& p = it->second.p_FinO;
     object_points.emplace_back(p.x(), p.y(), p.z());
     image_points.emplace_back(z.x(), z.y());
   }
@@ -418,37 +487,28 @@ ObjectTracker::Pose ObjectTracker::predict_pose(const Observations& obs) const {
 void ObjectTracker::add_observations(int64_t utime, const Observations& obs, const Pose& pose) {
   window_.push_back(utime);
   poses_[utime] = pose;
-  // New features start at the median depth of the current points.
-  std::vector<double> depths;
-  for (const auto& [id, z] : obs) {
-    const auto it = features_.find(id);
-    if (it == features_.end() || !it->second.in_ba) continue;
-    depths.push_back((pose.q_OtoC * point_in_O(it->second) + pose.pbar_OinC).z());
-  }
-  const double depth = depths.empty() ? 1.0 : median(depths);
-  for (const auto& [id, z] : obs) {
-    Feature& f = features_[id];
-    if (f.observations.empty()) {
-      f.anchor_utime = utime;
-      f.bearing = homogeneous(z);
-      f.inverse_depth = depth > 0.0 ? 1.0 / depth : 1.0;
-    }
-    f.observations[utime] = z;
-  }
+  for (const auto& [id, z] : obs) features_[id].observations[utime] = z;
   // A feature joins the BA once it has enough views and parallax; its
-  // inverse depth then comes from the anchor and the current view.
+  // point then comes from its oldest view in the window and the current.
   for (auto& [id, f] : features_) {
     if (f.in_ba || !obs.count(id) || static_cast<int>(f.observations.size()) < options_.min_feature_observations) {
       continue;
     }
     if (feature_parallax_rad(f) < options_.min_feature_parallax_deg * kDegToRad) continue;
-    const Pose& a = poses_.at(f.anchor_utime);
-    const Eigen::Matrix3d R_CatoC = pose.q_OtoC.toRotationMatrix() * a.q_OtoC.toRotationMatrix().transpose();
+    const auto& [first_utime, first_z] = *f.observations.begin();
+    const Pose& a = poses_.at(first_utime);
+    const Eigen::Matrix3d R_OtoCa = a.q_OtoC.toRotationMatrix();
+    const Eigen::Matrix3d R_CatoC = pose.q_OtoC.toRotationMatrix() * R_OtoCa.transpose();
     const Eigen::Vector3d p_CainC = pose.pbar_OinC - R_CatoC * a.pbar_OinC;
-    const std::optional<Eigen::Vector3d> X = triangulate(f.bearing, homogeneous(obs.at(id)), R_CatoC, p_CainC);
+    const std::optional<Eigen::Vector3d> X = triangulate(homogeneous(first_z), homogeneous(obs.at(id)), R_CatoC, p_CainC);
     if (!X) continue;
-    f.inverse_depth = 1.0 / X->z();
-    f.in_ba = true;
+    f.p_FinO = R_OtoCa.transpose() * (*X - a.pbar_OinC);
+    // Only a point that fits all its views joins: a wrong one (a mismatch,
+    // or a two-view depth off in a bad geometry) would pull the poses before
+    // the outlier removal sees it, and take good points with it.
+    f.in_ba = std::all_of(f.observations.begin(), f.observations.end(), [&](const auto& o) {
+      return reprojection_error_px(f, o.first, o.second) <= options_.outlier_threshold_px;
+    });
   }
 }
 
@@ -475,28 +535,19 @@ bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
   };
   for (auto& [id, f] : features_) {
     if (!f.in_ba) continue;
-    Pose& anchor = poses_.at(f.anchor_utime);
     for (const auto& [utime, z] : f.observations) {
-      if (utime == f.anchor_utime || utime < window_.front()) continue;
       Pose& pose = poses_.at(utime);
-      add_pose(anchor);
       add_pose(pose);
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<InverseDepthReprojection, 2, 4, 3, 4, 3, 1>(
-              new InverseDepthReprojection(f.bearing, z)),
-          loss.get(), anchor.q_OtoC.coeffs().data(), anchor.pbar_OinC.data(), pose.q_OtoC.coeffs().data(),
-          pose.pbar_OinC.data(), &f.inverse_depth);
-      // A point in front of the anchor camera; also keeps 1/rho finite.
-      problem.SetParameterLowerBound(&f.inverse_depth, 0, 1e-3);
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointReprojection, 2, 4, 3, 3>(new PointReprojection(z)),
+                               loss.get(), pose.q_OtoC.coeffs().data(), pose.pbar_OinC.data(), f.p_FinO.data());
     }
-    if (f.frozen && problem.HasParameterBlock(&f.inverse_depth)) problem.SetParameterBlockConstant(&f.inverse_depth);
   }
   if (problem.NumResidualBlocks() == 0) return false;
-  // Gauge: the oldest window poses and every pose outside the window.
+  // Gauge: the oldest window poses and the retired ones.
   for (auto& [utime, pose] : poses_) {
     const auto pos = std::find(window_.begin(), window_.end(), utime);
-    const bool fixed = pos == window_.end() || pos - window_.begin() < num_fixed_poses;
-    if (fixed && problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
+    if ((pos == window_.end() || pos - window_.begin() < num_fixed_poses) &&
+        problem.HasParameterBlock(pose.q_OtoC.coeffs().data())) {
       problem.SetParameterBlockConstant(pose.q_OtoC.coeffs().data());
       problem.SetParameterBlockConstant(pose.pbar_OinC.data());
     }
@@ -509,8 +560,6 @@ bool ObjectTracker::solve_window(int num_fixed_poses, int max_iterations) {
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   if (!summary.IsSolutionUsable()) return false;
-  last_cost_ = summary.final_cost;
-  last_num_residuals_ = problem.NumResidualBlocks();
   for (auto& [utime, pose] : poses_) {
     if (!pose.q_OtoC.coeffs().allFinite() || !pose.pbar_OinC.allFinite()) return false;
     pose.q_OtoC.normalize();
@@ -529,10 +578,6 @@ int ObjectTracker::remove_outliers() {
     int rejected = 0;
     int kept = 0;
     for (auto o = f.observations.begin(); o != f.observations.end();) {
-      if (o->first == f.anchor_utime || o->first < window_.front()) {
-        ++o;
-        continue;
-      }
       if (reprojection_error_px(f, o->first, o->second) > options_.outlier_threshold_px) {
         o = f.observations.erase(o);
         ++rejected;
@@ -542,7 +587,7 @@ int ObjectTracker::remove_outliers() {
       }
     }
     removed += rejected;
-    // Most views disagree: the anchor view (the bearing) is the outlier.
+    // Most views disagree: the point itself is wrong.
     if (rejected > 0 && kept <= rejected) {
       it = features_.erase(it);
     } else {
@@ -561,34 +606,29 @@ void ObjectTracker::slide_window() {
   while (window_.size() > static_cast<std::size_t>(options_.window_size)) {
     const int64_t oldest = window_.front();
     window_.pop_front();
+    // The leaving pose is retired, not forgotten: it stays (constant) with
+    // its views of the BA points while they live, so those views keep
+    // constraining the points and, through them, carry the gauge. Freezing
+    // the points instead would keep their early (e.g. the initialisation's)
+    // errors for good.
     for (auto& [id, f] : features_) {
-      if (f.anchor_utime == oldest) {
-        f.frozen = true;
-      } else {
-        f.observations.erase(oldest);
-      }
+      if (!f.in_ba) f.observations.erase(oldest);
     }
   }
   // Feature ids are never reused after a track loss, so a candidate not seen
   // now can never join, and a BA feature without views in the window is gone.
+  std::set<int64_t> referenced(window_.begin(), window_.end());
   for (auto it = features_.begin(); it != features_.end();) {
     const Feature& f = it->second;
     const bool seen_now = f.observations.count(current) > 0;
-    const bool in_window = f.observations.lower_bound(window_.front()) != f.observations.end();
-    const bool anchor_gone = f.anchor_utime < window_.front();
-    if ((!f.in_ba && (!seen_now || anchor_gone)) || !in_window) {
+    if ((!f.in_ba && !seen_now) || f.observations.lower_bound(window_.front()) == f.observations.end()) {
       it = features_.erase(it);
     } else {
+      for (const auto& [utime, z] : f.observations) referenced.insert(utime);
       ++it;
     }
   }
-  for (auto it = poses_.begin(); it != poses_.end();) {
-    const int64_t utime = it->first;
-    const bool needed = utime >= window_.front() ||
-                        std::any_of(features_.begin(), features_.end(),
-                                    [&](const auto& kv) { return kv.second.anchor_utime == utime; });
-    it = needed ? std::next(it) : poses_.erase(it);
-  }
+  for (auto it = poses_.begin(); it != poses_.end();) it = referenced.count(it->first) ? std::next(it) : poses_.erase(it);
 }
 
 bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
@@ -603,25 +643,7 @@ bool ObjectTracker::is_keyframe(int64_t utime, int64_t previous_utime) const {
 }
 
 void ObjectTracker::drop_frame(int64_t utime) {
-  const int64_t current = window_.back();
-  for (auto it = features_.begin(); it != features_.end();) {
-    Feature& f = it->second;
-    if (f.anchor_utime == utime) {
-      // Re-anchored in the current frame, where the point keeps its place.
-      const auto z = f.observations.find(current);
-      const Pose& pose = poses_.at(current);
-      const double depth = z == f.observations.end() ? -1.0 : (pose.q_OtoC * point_in_O(f) + pose.pbar_OinC).z();
-      if (depth <= 0.0) {
-        it = features_.erase(it);
-        continue;
-      }
-      f.anchor_utime = current;
-      f.bearing = homogeneous(z->second);
-      f.inverse_depth = 1.0 / depth;
-    }
-    f.observations.erase(utime);
-    ++it;
-  }
+  for (auto& [id, f] : features_) f.observations.erase(utime);
   window_.erase(std::find(window_.begin(), window_.end(), utime));
   poses_.erase(utime);
 }
@@ -631,24 +653,21 @@ void ObjectTracker::reset() {
   window_.clear();
   poses_.clear();
   features_.clear();
+  aliases_.clear();
   init_frames_.clear();
 }
 
-Eigen::Vector3d ObjectTracker::point_in_O(const Feature& f) const {
-  const Pose& a = poses_.at(f.anchor_utime);
-  return a.q_OtoC.conjugate() * (f.bearing / f.inverse_depth - a.pbar_OinC);
-}
-
 double ObjectTracker::feature_parallax_rad(const Feature& f) const {
-  const auto& [utime, z] = *f.observations.rbegin();
+  const auto& [first_utime, first_z] = *f.observations.begin();
+  const auto& [last_utime, last_z] = *f.observations.rbegin();
   const Eigen::Matrix3d R_CtoCa =
-      poses_.at(f.anchor_utime).q_OtoC.toRotationMatrix() * poses_.at(utime).q_OtoC.toRotationMatrix().transpose();
-  return angle_between(f.bearing, R_CtoCa * homogeneous(z));
+      poses_.at(first_utime).q_OtoC.toRotationMatrix() * poses_.at(last_utime).q_OtoC.toRotationMatrix().transpose();
+  return angle_between(homogeneous(first_z), R_CtoCa * homogeneous(last_z));
 }
 
 double ObjectTracker::reprojection_error_px(const Feature& f, int64_t utime, const Eigen::Vector2d& z) const {
   const Pose& pose = poses_.at(utime);
-  const Eigen::Vector3d p_FinC = pose.q_OtoC * point_in_O(f) + pose.pbar_OinC;
+  const Eigen::Vector3d p_FinC = pose.q_OtoC * f.p_FinO + pose.pbar_OinC;
   if (!(p_FinC.z() > 0.0)) return std::numeric_limits<double>::infinity();
   return (p_FinC.head<2>() / p_FinC.z() - z).norm() * options_.focal_length_px;
 }
@@ -662,7 +681,7 @@ ObjectPoseEstimate ObjectTracker::make_estimate(int64_t utime, const Observation
   for (const auto& [id, z] : obs) {
     const auto it = features_.find(id);
     if (it == features_.end() || !it->second.in_ba || !it->second.observations.count(utime)) continue;
-    const double err = utime == it->second.anchor_utime ? 0.0 : reprojection_error_px(it->second, utime, z);
+    const double err = reprojection_error_px(it->second, utime, z);
     sum_sq += err * err;
     ++e.num_features;
   }

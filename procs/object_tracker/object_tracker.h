@@ -20,16 +20,17 @@
 // |p_FinC| at reference_utime (see InitFacts).
 //
 // Scale consistency: the two oldest window poses are held constant, and a
-// feature whose anchor frame has left the window is frozen (anchor pose and
-// inverse depth constant); those frozen points carry the gauge forward. The
+// pose that leaves the window is retired: constant, its views of the
+// points (3D, in O) kept while those live; they carry the gauge forward. The
 // window keeps keyframes (the newest-but-one frame is dropped unless it
 // moved enough), so its N frames span more motion than N consecutive ones.
 //
-// Initialisation: frames join a buffer once the image moved; with
-// `init_frames` buffered, a two-view (essential matrix) between the first
-// and the last gives depths, the frames in between are posed by PnP and all
-// go through a BA. A small object projects almost affinely, so the
-// depth-reversed structure is solved too and the cheaper kept.
+// Initialisation: every frame joins a buffer; with `init_frames` buffered,
+// a two-view (essential matrix) between the first and the last gives
+// depths, the frames in between are posed by PnP and all go through a BA. A
+// small object projects almost affinely, so the depth-reversed structure is
+// solved too; the tracker commits only if one is clearly cheaper
+// (`init_min_chi2_gap`), else the buffer slides on.
 //
 // Internally poses are Ceres parameter blocks (Eigen::Quaterniond, whose
 // coefficient order x y z w is what EigenQuaternionManifold expects); they
@@ -57,8 +58,10 @@ struct ObjectTrackerOptions {
   double robust_loss_px{1.5};           // px, scale of the robust loss
   int min_init_features{20};            // common target features needed to initialise
   double min_init_parallax_deg{2.0};    // median rotation-compensated parallax to initialise
-  int init_frames{20};                  // frames the initialisation BA spans (reference to current)
-  double init_min_displacement_px{5.0}; // median image motion for a frame to join the initialisation
+  int init_frames{40};                  // consecutive frames the initialisation BA spans
+  // The initialisation commits to one of the two (Necker) structures only if
+  // the other's cost over the buffer is larger by this chi-square margin.
+  double init_min_chi2_gap{25.0};
   double ransac_threshold_px{1.5};      // px, essential matrix and PnP RANSAC
   int reference_features{5};            // features nearest the centre ray that define depth 1
   int min_track_features{10};           // fewer BA features in a frame: track lost
@@ -72,6 +75,10 @@ struct ObjectTrackerOptions {
   // more relative motion than N consecutive frames.
   double keyframe_rotation_deg{3.0};
   double keyframe_baseline{0.05};       // tracker units (1 = the initial object distance)
+  // A new feature id observed within this distance of the projection of
+  // one BA point not seen in the frame (and no other within twice it) is
+  // that point again (a broken track of the front end).
+  double reassociation_px{4.0};
 };
 
 /// Reads the `object_tracker:` section (every key optional, defaults above).
@@ -124,12 +131,9 @@ class ObjectTracker {
     Eigen::Vector3d pbar_OinC{Eigen::Vector3d::Zero()};
   };
   struct Feature {
-    int64_t anchor_utime{0};
-    Eigen::Vector3d bearing{Eigen::Vector3d::UnitZ()};  // [x y 1] in the anchor camera
-    double inverse_depth{1.0};                          // 1 / z in the anchor camera
-    std::map<int64_t, Eigen::Vector2d> observations;    // utime -> normalized (anchor included)
+    Eigen::Vector3d p_FinO{Eigen::Vector3d::Zero()};  // tracker units; set when it joins the BA
+    std::map<int64_t, Eigen::Vector2d> observations;  // utime (window or retired pose) -> normalized
     bool in_ba{false};
-    bool frozen{false};  // anchor left the window: point constant
   };
   using Observations = std::map<int64_t, Eigen::Vector2d>;  // feature id -> normalized
   struct InitFrame {
@@ -139,7 +143,9 @@ class ObjectTracker {
   };
 
   ObjectPoseEstimate try_initialise(InitFrame frame);
-  ObjectPoseEstimate track(int64_t utime, const Observations& obs);
+  ObjectPoseEstimate track(int64_t utime, const Observations& raw_obs);
+  Observations with_aliases(const Observations& obs) const;
+  Observations associate(const Observations& raw_obs, const Pose& pose);
   Pose predict_pose(const Observations& obs) const;
   void add_observations(int64_t utime, const Observations& obs, const Pose& pose);
   bool solve_window(int num_fixed_poses, int max_iterations);
@@ -148,7 +154,6 @@ class ObjectTracker {
   bool is_keyframe(int64_t utime, int64_t previous_utime) const;
   void drop_frame(int64_t utime);
   void reset();
-  Eigen::Vector3d point_in_O(const Feature& f) const;
   double feature_parallax_rad(const Feature& f) const;
   double reprojection_error_px(const Feature& f, int64_t utime, const Eigen::Vector2d& z) const;
   ObjectPoseEstimate make_estimate(int64_t utime, const Observations& obs) const;
@@ -159,8 +164,6 @@ class ObjectTracker {
   int64_t next_track_id_{1};
   std::optional<InitFacts> init_facts_;
   double last_solve_seconds_{0.0};
-  double last_cost_{0.0};      // final cost of the last solve_window()
-  int last_num_residuals_{0};  // its number of observations
 
   bool tracking_{false};
   // Initialisation buffer: frames since the reference frame.
@@ -168,8 +171,9 @@ class ObjectTracker {
 
   // Tracking state.
   std::deque<int64_t> window_;    // utimes, oldest first
-  std::map<int64_t, Pose> poses_; // window poses and anchors of frozen features
+  std::map<int64_t, Pose> poses_; // window and retired poses
   std::map<int64_t, Feature> features_;
+  std::map<int64_t, int64_t> aliases_;  // front-end feature id -> the feature it continues
 };
 
 }  // namespace vimot

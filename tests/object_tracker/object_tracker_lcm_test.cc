@@ -27,7 +27,7 @@ TEST_CASE("object pose round trip through object_pose_t", "[object_tracker]") {
   CHECK(back.pbar_OinC == e.pbar_OinC);
   CHECK(back.num_features == 42);
   CHECK(back.reprojection_rms_px == 0.7);
-  CHECK(back.track_id == 0);  // not carried by the message
+  CHECK(back.track_id == 3);
 }
 
 TEST_CASE("object_pose_t: a valid pose must be finite, an invalid one is not read", "[object_tracker]") {

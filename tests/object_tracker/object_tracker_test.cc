@@ -1,28 +1,32 @@
 // ObjectTracker against the simulator's truth (config/sim_mono.yaml: a
-// 0.4 x 0.3 x 0.3 m box at ~2.2 m from a hand-held camera, 20 Hz, fx = 458 px).
+// 0.4 x 0.3 x 0.3 m box at 1.8-3.4 m from a hand-held camera, 20 Hz,
+// fx = 458 px).
 //
 // Error bounds, from the geometry (not from runs):
-//  * initialisation: the two-view needs 20 buffered frames, each after 5 px
-//    of median image motion (init_frames, init_min_displacement_px). The box
-//    moves in the image at about v/Z f = 0.3 m/s / 2.2 m * 458 px ≈ 60 px/s,
-//    half that in the slow parts of the figure-eight: 100 px in ≤ 3.5 s.
-//    Valid output is required from 4 s (80 frames at 20 Hz) on.
+//  * initialisation: every frame is buffered; the two-view + BA runs on 40
+//    frames (init_frames, 2 s at 20 Hz) and commits once one of the two
+//    Necker structures is clearly better, which the perspective of the
+//    tilted box should give within about 2 s more: valid output is required
+//    from 4 s (80 frames) on.
 //  * noise-free pixels: the BA residual is zero at the truth; what is left is
 //    the solver's convergence and the undistortion (< 1e-9), far below
 //    0.01° and 1 mm (0.05 % of the 2 m range), which any modelling error
 //    (a wrong frame, sign or gauge) would exceed by orders.
-//  * 1 px noise (σ = 1/458 rad = 2.2 mrad per axis): the box spans
-//    a = 0.4 m / 2.2 m ≈ 0.18 rad and its depth relief is r = ΔZ/Z ≈ 0.14, so
-//    it projects almost affinely; rotation out of the image plane is seen
-//    only through perspective, to ≈ σ/(a r) ≈ 5° per feature and frame
-//    (bas-relief ambiguity). The gauge (O's orientation) is fixed by the
-//    initialisation window, whose errors are correlated over its frames:
-//    bound 10° RMS (twice the single-feature figure). Position: the
-//    consumer (scale estimator) needs a few %: bound 5 % of the mean range
-//    (depth is set by the reference features' median depth, triangulated
-//    with ≥ 2° of parallax: σ/θ/√5 ≈ 3 %). Scale drift end vs start: 10 %.
-//  * measured (see docs/object_tracker.md) is well inside these, except the
-//    outlier case, which is open (tagged [!mayfail]).
+//  * 1 px noise (σ = 1/458 rad = 2.2 mrad per axis), mean range Z ≈ 2.5 m:
+//    with the structure known, a rotation δθ out of the image plane moves
+//    a point at depth offset z_i by z_i δθ / Z; the visible faces spread
+//    z_i by ≈ 0.1 m, so N ≈ 50 points give σ_θ ≈ σ Z / (0.1 m √N) ≈ 0.45°
+//    per out-of-plane axis, ≈ 0.6° for both (the Cramér-Rao bound from the
+//    simulator's true points and all three axes is 0.7° per frame). O's
+//    orientation is the reference frame's estimated pose, one more such
+//    single-frame error, constant over the track: √2 · 0.7° ≈ 1.0°; bound
+//    1.5° RMS leaves half a degree for the structure (the
+//    issue asks for about a degree). Position: the range follows from the
+//    image size of the box (≈ 80 px at 2.5 m) to σ/(40 px √N) ≈ 0.4 % ≈ 1 cm
+//    and the lateral position to σ Z / √N < 1 mm; with the rotation error
+//    moving O (≈ d_ref from the camera along the ray) bound 0.05 m RMS.
+//    Scale drift (last 2 s vs the reference features): the scale estimator
+//    needs < 1 % over a 60 s track; 25 s here: bound 1 %.
 
 #include <catch2/catch.hpp>
 
@@ -161,9 +165,9 @@ TEST_CASE("1 px noise: rotation and position within the geometric bounds", "[obj
   std::printf("1 px: mean BA time %.2f ms per frame\n", solve_ms);
   CHECK(tracker.counters().initialisations == 1);
   CHECK(a.valid >= a.frames - 80);
-  CHECK(a.rotation_rms_deg < 10.0);
-  CHECK(a.position_rms_m < 0.05 * a.mean_range_m);
-  CHECK(std::abs(a.scale_drift) < 0.10);
+  CHECK(a.rotation_rms_deg < 1.5);
+  CHECK(a.position_rms_m < 0.05);
+  CHECK(std::abs(a.scale_drift) < 0.01);
 }
 
 TEST_CASE("a 1 s gap without target observations gives a new track, accurate again", "[object_tracker]") {
@@ -191,13 +195,15 @@ TEST_CASE("a 1 s gap without target observations gives a new track, accurate aga
   // The new track re-initialises within 4 s (as at the start) and has the
   // accuracy bounds of the 1 px case.
   CHECK(second.valid >= 20 * 11 - 80);
-  CHECK(second.rotation_rms_deg < 10.0);
-  CHECK(second.position_rms_m < 0.05 * second.mean_range_m);
+  CHECK(second.rotation_rms_deg < 1.5);
+  CHECK(second.position_rms_m < 0.05);
 }
 
-// Open: with these outliers the initialisation takes ~12 s and then settles
-// in the depth-reversed solution (docs/object_tracker.md, "Open issues").
-TEST_CASE("5 % of the target observations 20 px off: the robust BA stays accurate", "[object_tracker][!mayfail]") {
+// 20 px is far outside the 1 px noise: RANSAC (1.5 px), the outlier removal
+// (3 px) and the check of a joining point (3 px) see every such view, so the
+// bounds are those of the 1 px case. (Open: over 60 s such runs still lose
+// the track when a new face comes into view; docs/object_tracker.md.)
+TEST_CASE("5 % of the target observations 20 px off: the robust BA stays accurate", "[object_tracker]") {
   ObjectTracker tracker;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -216,8 +222,8 @@ TEST_CASE("5 % of the target observations 20 px off: the robust BA stays accurat
   CHECK(tracker.counters().removed_outlier_observations > 0);
   CHECK(tracker.counters().initialisations == 1);
   CHECK(a.valid >= a.frames - 80);
-  CHECK(a.rotation_rms_deg < 10.0);
-  CHECK(a.position_rms_m < 0.05 * a.mean_range_m);
+  CHECK(a.rotation_rms_deg < 1.5);
+  CHECK(a.position_rms_m < 0.05);
 }
 
 TEST_CASE("bad input is counted and never crashes", "[object_tracker]") {
