@@ -15,9 +15,10 @@
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
 #                     sim_mono.yaml)
-#   VIMOT_SPEED       simulator real-time factor (default 4; on 2 cores, 10 is
-#                     too fast for the target filter: UDP drops messages and
-#                     the LCM figures no longer equal the offline ones)
+#   VIMOT_SPEED       simulator real-time factor (default 4; mono: 1, the object
+#                     tracker's bundle adjustment takes ≈ 20 ms per frame; on 2
+#                     cores, 10 is too fast for the target filter: UDP drops
+#                     messages and the LCM figures no longer equal the offline ones)
 #   VIMOT_SEED        noise seed (default 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml; mono:
 #                     vins_mono.yaml)
@@ -47,6 +48,7 @@ if [ $pipeline = mono ]; then
   pmd="$here/sheriff_configs/sim_mono.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_mono.yaml}"
   export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
+  export VIMOT_SPEED="${VIMOT_SPEED:-1}"
 else
   pmd="$here/sheriff_configs/sim_demo.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
