@@ -18,6 +18,20 @@ namespace eval {
 using estimator::FrameStatus;
 using estimator::VioEstimator;
 
+void play_simulator(sim::Simulator& sim, estimator::VioEstimator& estimator,
+                    const std::function<void(const GroundTruth&)>& on_truth,
+                    const std::function<bool(const CameraFrame&)>& on_frame) {
+  while (std::optional<sim::SimEvent> ev = sim.next()) {
+    if (const auto* imu = std::get_if<ImuData>(&*ev)) {
+      estimator.feed_imu(*imu);
+    } else if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
+      on_truth(*gt);
+    } else if (!on_frame(std::get<CameraFrame>(*ev))) {
+      return;
+    }
+  }
+}
+
 SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                             uint64_t perturb_seed, const SimRunOptions& ro) {
   const auto wall_start = std::chrono::steady_clock::now();
@@ -48,17 +62,11 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
   estimator::FrameTiming stage_sum;
   const double cameras_used = options.use_stereo ? static_cast<double>(options.cameras.size()) : 1.0;
 
-  while (std::optional<sim::SimEvent> ev = sim.next()) {
-    if (const auto* imu = std::get_if<ImuData>(&*ev)) {
-      est.feed_imu(*imu);
-      continue;
-    }
-    if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
-      last_truth = *gt;
-      have_truth = true;
-      continue;
-    }
-    const auto& frame = std::get<CameraFrame>(*ev);
+  auto on_truth = [&](const GroundTruth& gt) {
+    last_truth = gt;
+    have_truth = true;
+  };
+  play_simulator(sim, est, on_truth, [&](const CameraFrame& frame) {
     ++frames_seen;
     for (const FeatureObservation& o : frame.observations) {
       if (!o.is_target && o.camera_id < cameras_used) static_obs += 1.0;
@@ -68,9 +76,9 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
     if (st == FrameStatus::kDiverged) {
       r.diverged = true;
       r.divergence_reason = est.last_divergence().reason;
-      break;
+      return false;
     }
-    if (st != FrameStatus::kProcessed) continue;
+    if (st != FrameStatus::kProcessed) return true;
     const estimator::FrameTiming& ft = est.last_timing();
     cpu_ms.push_back(ft.total_cpu_ms);
     stage_sum.propagate_ms += ft.propagate_ms;
@@ -84,7 +92,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
     // truth of this frame, if any, is the last GroundTruth event.
     if (!have_truth || last_truth.utime != frame.utime) {
       ++r.frames_without_truth;
-      continue;
+      return true;
     }
     const NavState x = nav_state_of(est, true);
     FrameSample s;
@@ -100,7 +108,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
     } catch (const std::invalid_argument& e) {
       r.diverged = true;
       r.divergence_reason = "IMU covariance not positive definite at utime " + std::to_string(x.utime);
-      break;
+      return false;
     }
     s.cpu_ms = est.last_timing().total_cpu_ms;
     s.num_slam = x.num_slam_features;
@@ -109,7 +117,8 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
     pairs.push_back(PosePair{s.q_GtoI, s.p_IinG, s.q_GtoI_true, s.p_IinG_true});
     if (ro.on_frame) ro.on_frame(est, s);
     if (ro.keep_samples) r.samples.push_back(s);
-  }
+    return true;
+  });
   if (ro.progress) ro.progress(1.0);
 
   r.errors = errors.summary();

@@ -29,6 +29,7 @@
 #include "common/eval/alignment.h"
 #include "common/eval/metrics.h"
 #include "common/sim/sim_config.h"
+#include "common/sim/simulator.h"
 
 namespace vimot {
 namespace eval {
@@ -80,6 +81,15 @@ struct SimRunResult {
   std::string divergence_reason;
   double wall_s{0.0};
 };
+
+/// Plays the simulator's events in time order into an estimator: IMU samples
+/// go to `estimator`, ground truth to `on_truth`, camera frames to
+/// `on_frame`, which returns false to stop. At equal utime the simulator
+/// emits IMU, GroundTruth, CameraFrame, so a frame's truth (if any) has
+/// arrived before it.
+void play_simulator(sim::Simulator& sim, estimator::VioEstimator& estimator,
+                    const std::function<void(const GroundTruth&)>& on_truth,
+                    const std::function<bool(const CameraFrame&)>& on_frame);
 
 /// One run on `sim_config` (its seed and duration as given).
 SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,

@@ -138,18 +138,12 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   bool have_truth = false;
   bool target_seen = false;
   int64_t frames_seen = 0;
-  while (std::optional<sim::SimEvent> ev = sim.next()) {
-    if (const auto* imu = std::get_if<ImuData>(&*ev)) {
-      est.feed_imu(*imu);
-      continue;
-    }
-    if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
-      truth = *gt;
-      have_truth = true;
-      if (filter) filter->set_ground_truth(*gt);
-      continue;
-    }
-    const auto& frame = std::get<CameraFrame>(*ev);
+  auto on_truth = [&](const GroundTruth& gt) {
+    truth = gt;
+    have_truth = true;
+    if (filter) filter->set_ground_truth(gt);
+  };
+  play_simulator(sim, est, on_truth, [&](const CameraFrame& frame) {
     ++frames_seen;
     for (const FeatureObservation& o : frame.observations) target_seen = target_seen || o.is_target;
     const FrameStatus st = est.feed_camera(frame);
@@ -157,10 +151,10 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     if (st == FrameStatus::kDiverged) {
       r.diverged = true;
       r.divergence_reason = est.last_divergence().reason;
-      break;
+      return false;
     }
-    if (st != FrameStatus::kProcessed) continue;
-    if (!have_truth || truth.utime != frame.utime || !target_seen) continue;
+    if (st != FrameStatus::kProcessed) return true;
+    if (!have_truth || truth.utime != frame.utime || !target_seen) return true;
     try {
       e_imu.add(error_of(nav_state_of(est, true), truth));
       if (filter && filter->initialized() && truth.has_target) {
@@ -198,9 +192,10 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     } catch (const std::invalid_argument& e) {
       r.diverged = true;
       r.divergence_reason = "covariance not positive definite at utime " + std::to_string(frame.utime) + ": " + e.what();
-      break;
+      return false;
     }
-  }
+    return true;
+  });
   if (progress) progress(1.0);
   r.target_in_imu = e_ti.summary();
   r.target_in_world = e_tg.summary();

@@ -10,6 +10,7 @@
 
 #include "common/eval/initial_estimate.h"
 #include "common/eval/nav_state_of.h"
+#include "common/eval/sim_runner.h"
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/sim/simulator.h"
@@ -154,24 +155,18 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
   bool have_truth = false;
   double tracker_s = 0.0;
   const int64_t frames_total = std::max<int64_t>(1, sim.camera_frame_count());
-  while (std::optional<sim::SimEvent> ev = sim.next()) {
-    if (const auto* imu = std::get_if<ImuData>(&*ev)) {
-      est.feed_imu(*imu);
-      continue;
-    }
-    if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
-      truth = *gt;
-      have_truth = true;
-      continue;
-    }
-    const auto& frame = std::get<CameraFrame>(*ev);
+  auto on_truth = [&](const GroundTruth& gt) {
+    truth = gt;
+    have_truth = true;
+  };
+  play_simulator(sim, est, on_truth, [&](const CameraFrame& frame) {
     ++r.frames;
     if (progress) progress(static_cast<double>(r.frames) / static_cast<double>(frames_total));
     const estimator::FrameStatus st = est.feed_camera(frame);  // it leaves the target's observations out
     if (st == estimator::FrameStatus::kDiverged) {
       r.vio_diverged = true;
       r.divergence_reason = est.last_divergence().reason;
-      break;
+      return false;
     }
     const auto t0 = std::chrono::steady_clock::now();
     const ObjectPoseEstimate pose = tracker.process(frame);
@@ -184,12 +179,13 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
         r.tracks.push_back(t);
       }
     }
-    if (st != estimator::FrameStatus::kProcessed) continue;
+    if (st != estimator::FrameStatus::kProcessed) return true;
     const NavState nav = nav_state_of(est, true);
     if (have_truth && truth.utime == frame.utime) vio_errors.add(error_of(nav, truth));
     node.on_nav_state(nav);
     node.on_object_pose(pose);
-  }
+    return true;
+  });
   if (progress) progress(1.0);
   r.vio = vio_errors.summary();
   r.figures = figures.figures();
