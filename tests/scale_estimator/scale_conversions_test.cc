@@ -77,5 +77,5 @@ TEST_CASE("scale config: the shipped file loads cam0's extrinsics and the thresh
   CHECK_THAT(o.camera.R_ItoC.determinant(), Catch::Matchers::WithinAbs(1.0, 1e-6));
   CHECK(o.estimator.window_size == 800);
   CHECK(o.estimator.rho_t1 == 1e-4);
-  CHECK(o.max_pending == 10);
+  CHECK(o.max_pending == 60);
 }
