@@ -4,6 +4,8 @@
 // depend on how IMU and camera messages interleave.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include <cmath>
 #include <map>
 #include <utility>
@@ -159,6 +161,58 @@ TEST_CASE("target filter node tracks the target within 3 sigma and predicts ever
   CHECK(back.covariance == last.covariance);
   const TargetPosePrediction pback = from_lcm(to_lcm(out.prediction.back()));
   CHECK(pback.covariance == out.prediction.back().covariance);
+}
+
+TEST_CASE("target filter node predicts through a segmentation failure and re-acquires", "[target_filter]") {
+  // No target observations between 4 s and 6 s (the segmentation lost the
+  // target): the node still publishes a target state every frame, its
+  // uncertainty grows, the truth stays inside 3σ, and afterwards the target
+  // is re-acquired (points back in the state, uncertainty shrinks again).
+  std::vector<sim::SimEvent> events = simulate(10.0);
+  std::map<int64_t, GroundTruth> truth;
+  int64_t t0 = -1;
+  for (auto& e : events) {
+    if (const auto* gt = std::get_if<GroundTruth>(&e)) truth[gt->utime] = *gt;
+    if (auto* frame = std::get_if<CameraFrame>(&e)) {
+      if (t0 < 0) t0 = frame->utime;
+      const double t = 1e-6 * static_cast<double>(frame->utime - t0);
+      if (t >= 4.0 && t < 6.0) {
+        auto& obs = frame->observations;
+        obs.erase(std::remove_if(obs.begin(), obs.end(), [](const FeatureObservation& o) { return o.is_target; }),
+                  obs.end());
+      }
+    }
+  }
+  const Outputs out = run_node(events, node_options());
+  auto sigma_p = [](const TargetStateEstimate& s) { return std::sqrt(s.covariance.block<3, 3>(3, 3).trace()); };
+  auto within_3_sigma = [&](const TargetStateEstimate& s) {
+    const GroundTruth& gt = truth.at(s.utime);
+    const Eigen::Vector3d err = s.p_TinI - quat_to_rot(gt.q_GtoI) * (gt.p_TinG - gt.p_IinG);
+    const Eigen::Matrix3d P = s.covariance.block<3, 3>(3, 3);
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) ok = ok && std::abs(err(k)) < 3.0 * std::sqrt(P(k, k));
+    return ok;
+  };
+  const TargetStateEstimate* gap_start = nullptr;
+  const TargetStateEstimate* gap_end = nullptr;
+  int in_gap = 0;
+  for (const TargetStateEstimate& s : out.target) {
+    const double t = 1e-6 * static_cast<double>(s.utime - t0);
+    if (t < 4.0) gap_start = &s;
+    if (t >= 4.0 && t < 6.0) {
+      ++in_gap;
+      gap_end = &s;
+    }
+  }
+  REQUIRE(gap_start != nullptr);
+  REQUIRE(gap_end != nullptr);
+  CHECK(in_gap == 20);  // 10 Hz: every frame of the gap has a (predicted) target state
+  CHECK(sigma_p(*gap_end) > 1.5 * sigma_p(*gap_start));
+  CHECK(within_3_sigma(*gap_end));
+  const TargetStateEstimate& last = out.target.back();
+  CHECK(last.num_target_points > 0);
+  CHECK(sigma_p(last) < 0.5 * sigma_p(*gap_end));
+  CHECK(within_3_sigma(last));
 }
 
 TEST_CASE("target filter node output does not depend on message interleaving", "[target_filter]") {

@@ -177,7 +177,7 @@ TEST_CASE("SKF target updates leave the robot estimate unchanged", "[target_filt
   REQUIRE_FALSE(base.diverged);
   REQUIRE(base.imu.size() > 150);
   for (const TargetRepresentation rep : {TargetRepresentation::kLocal, TargetRepresentation::kGlobal}) {
-    for (const double sigma_t : {0.001, 0.05, 0.5}) {
+    for (const double sigma_t : {0.001, 0.005, 0.01, 0.05, 0.1, 0.5}) {  // the paper's sweep
       const Run r = run(filter_options(TargetUpdateMode::kSkf, rep, sigma_t));
       const double d = max_robot_difference(base, r);
       std::printf("SKF %s sigma_t %.3f: target updates %lld (tracks %lld, chi2 rej %lld, tri rej %lld), "
