@@ -420,6 +420,49 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
   apply_update(state, layout.order(), H, r);
 }
 
+estimator::ColumnLayout TargetFilter::clone_layout(const State& state, const std::set<int64_t>& times) const {
+  const bool global = options_.representation == TargetRepresentation::kGlobal;
+  estimator::ColumnLayout layout;
+  for (const auto& kv : clones_) {
+    if (times.count(kv.first) == 0) continue;
+    layout.col(kv.second);
+    if (global) layout.col(state.clone_at(kv.first));
+  }
+  return layout;
+}
+
+bool TargetFilter::track_system(const State& state, const estimator::Feature& f, const Eigen::Vector3d& p_FinT,
+                                estimator::ColumnLayout& layout, Eigen::MatrixXd* H_x, Eigen::MatrixXd* H_f,
+                                Eigen::VectorXd* r) const {
+  const bool global = options_.representation == TargetRepresentation::kGlobal;
+  const auto& cameras = estimator_.cameras();
+  const int m = f.num_obs();
+  *H_x = Eigen::MatrixXd::Zero(2 * m, layout.total());
+  *H_f = Eigen::MatrixXd::Zero(2 * m, 3);
+  *r = Eigen::VectorXd::Zero(2 * m);
+  bool ok = true;
+  int row = 0;
+  for (const auto& kv : f.obs) {
+    if (kv.first < 0 || kv.first >= static_cast<int>(cameras.size())) return false;
+    const estimator::CameraInfo& cam = cameras[static_cast<size_t>(kv.first)];
+    const CameraExtrinsics ext{cam.R_ItoC, cam.p_IinC};
+    for (const auto& o : kv.second) {
+      const auto tclone = clones_.at(o.utime);
+      const auto iclone = state.clone_at(o.utime);
+      const TargetPointPrediction pred =
+          predict_fej(options_.representation, *iclone, *tclone, p_FinT, p_FinT, ext, state.options().use_fej);
+      ok = ok && pred.valid;
+      const Eigen::Matrix2d W = cam.whitening(o.uv);
+      H_x->block<2, 6>(row, layout.col(tclone)) = W * pred.H_target_pose;
+      if (global) H_x->block<2, 6>(row, layout.col(iclone)) = W * pred.H_imu_pose;
+      H_f->block<2, 3>(row, 0) = W * pred.H_point;
+      r->segment<2>(row) = W * (o.uv - pred.z);
+      row += 2;
+    }
+  }
+  return ok;
+}
+
 void TargetFilter::initialize_points(State& state, int64_t utime) {
   std::vector<std::shared_ptr<estimator::Feature>> cands;
   for (const auto& f : tracks_.observed_at(utime)) {
@@ -445,11 +488,11 @@ void TargetFilter::initialize_points(State& state, int64_t utime) {
     const int na = a->num_obs(), nb = b->num_obs();
     return na != nb ? na > nb : a->feature_id < b->feature_id;
   });
-  const bool global = options_.representation == TargetRepresentation::kGlobal;
   const auto& cameras = estimator_.cameras();
   std::set<int64_t> times;
   const estimator::ClonePoses poses_in_T = poses_in_target(state, &times);
   const estimator::FeatureTriangulator triangulator(options_.triangulation, cameras);
+  estimator::ColumnLayout layout = clone_layout(state, times);  // col() of a present variable only looks up
   int added = 0;
   for (auto& f : cands) {
     if (added >= room) break;
@@ -459,40 +502,10 @@ void TargetFilter::initialize_points(State& state, int64_t utime) {
       continue;
     }
     const Eigen::Vector3d p_FinT = f->p_FinG;
-    estimator::ColumnLayout layout;
-    for (const auto& kv : clones_) {
-      if (times.count(kv.first) == 0) continue;
-      layout.col(kv.second);
-      if (global) layout.col(state.clone_at(kv.first));
-    }
     const int m = f->num_obs();
-    Eigen::MatrixXd H_R = Eigen::MatrixXd::Zero(2 * m, layout.total());
-    Eigen::MatrixXd H_L = Eigen::MatrixXd::Zero(2 * m, 3);
-    Eigen::VectorXd r(2 * m);
-    bool ok = true;
-    int row = 0;
-    for (const auto& kv : f->obs) {
-      if (kv.first < 0 || kv.first >= static_cast<int>(cameras.size())) {
-        ok = false;
-        break;
-      }
-      const estimator::CameraInfo& cam = cameras[static_cast<size_t>(kv.first)];
-      const CameraExtrinsics ext{cam.R_ItoC, cam.p_IinC};
-      for (const auto& o : kv.second) {
-        const auto tclone = clones_.at(o.utime);
-        const auto iclone = state.clone_at(o.utime);
-        const TargetPointPrediction pred = predict_fej(options_.representation, *iclone, *tclone, p_FinT, p_FinT, ext,
-                                                       state.options().use_fej);
-        if (!pred.valid) ok = false;
-        const Eigen::Matrix2d W = cam.whitening(o.uv);
-        H_R.block<2, 6>(row, layout.col(tclone)) = W * pred.H_target_pose;
-        if (global) H_R.block<2, 6>(row, layout.col(iclone)) = W * pred.H_imu_pose;
-        H_L.block<2, 3>(row, 0) = W * pred.H_point;
-        r.segment<2>(row) = W * (o.uv - pred.z);
-        row += 2;
-      }
-      if (!ok) break;
-    }
+    Eigen::MatrixXd H_R, H_L;
+    Eigen::VectorXd r;
+    const bool ok = track_system(state, *f, p_FinT, layout, &H_R, &H_L, &r);
     if (!ok) {
       ++stats_.points_rejected_init;
       continue;
@@ -538,18 +551,11 @@ void TargetFilter::initialize_points(State& state, int64_t utime) {
 
 void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estimator::Feature>> tracks) {
   if (tracks.empty()) return;
-  const bool global = options_.representation == TargetRepresentation::kGlobal;
   const auto& cameras = estimator_.cameras();
   std::set<int64_t> times;
   const estimator::ClonePoses poses_in_T = poses_in_target(state, &times);
   const estimator::FeatureTriangulator triangulator(options_.triangulation, cameras);
-
-  estimator::ColumnLayout layout;
-  for (const auto& kv : clones_) {
-    if (times.count(kv.first) == 0) continue;
-    layout.col(kv.second);
-    if (global) layout.col(state.clone_at(kv.first));
-  }
+  estimator::ColumnLayout layout = clone_layout(state, times);  // col() of a present variable only looks up
   const Eigen::MatrixXd P_xx = StateHelper::marginal_covariance(state, layout.order());
 
   std::vector<Eigen::MatrixXd> Hs;
@@ -567,30 +573,10 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
       ++stats_.rejected_triangulation;
       continue;
     }
-    const Eigen::Vector3d p_FinT = f->p_FinG;
     const int m = f->num_obs();
-    Eigen::MatrixXd H_x = Eigen::MatrixXd::Zero(2 * m, layout.total());
-    Eigen::MatrixXd H_f = Eigen::MatrixXd::Zero(2 * m, 3);
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(2 * m);
-    bool ok = true;
-    int row = 0;
-    for (const auto& kv : f->obs) {
-      const estimator::CameraInfo& cam = cameras[static_cast<size_t>(kv.first)];
-      const CameraExtrinsics ext{cam.R_ItoC, cam.p_IinC};
-      for (const auto& o : kv.second) {
-        const auto tclone = clones_.at(o.utime);
-        const auto iclone = state.clone_at(o.utime);
-        const TargetPointPrediction pred = predict_fej(options_.representation, *iclone, *tclone, p_FinT, p_FinT, ext,
-                                                       state.options().use_fej);
-        if (!pred.valid) ok = false;
-        const Eigen::Matrix2d W = cam.whitening(o.uv);
-        H_x.block<2, 6>(row, layout.col(tclone)) = W * pred.H_target_pose;
-        if (global) H_x.block<2, 6>(row, layout.col(iclone)) = W * pred.H_imu_pose;
-        H_f.block<2, 3>(row, 0) = W * pred.H_point;
-        r.segment<2>(row) = W * (o.uv - pred.z);
-        row += 2;
-      }
-    }
+    Eigen::MatrixXd H_x, H_f;
+    Eigen::VectorXd r;
+    const bool ok = track_system(state, *f, f->p_FinG, layout, &H_x, &H_f, &r);
     if (!ok) {
       ++stats_.rejected_triangulation;
       continue;

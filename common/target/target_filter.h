@@ -197,6 +197,14 @@ class TargetFilter : public estimator::VioExtension {
   estimator::ClonePoses poses_in_target(const estimator::State& state, std::set<int64_t>* times) const;
   // Every variable but the target, its clones and the target points.
   std::vector<estimator::TypePtr> nuisance_variables(const estimator::State& state) const;
+  // Target clones (and IMU clones, global) at `times`, in clone order.
+  estimator::ColumnLayout clone_layout(const estimator::State& state, const std::set<int64_t>& times) const;
+  // Whitened system of one target track over those clones, r = H_x δx + H_f δp_FinT
+  // (prediction at the estimates, Jacobians at the first estimates). False if an
+  // observation names an unknown camera or lies behind one.
+  bool track_system(const estimator::State& state, const estimator::Feature& f, const Eigen::Vector3d& p_FinT,
+                    estimator::ColumnLayout& layout, Eigen::MatrixXd* H_x, Eigen::MatrixXd* H_f,
+                    Eigen::VectorXd* r) const;
   // ekf_update (kEkf) or schmidt_update with nuisance_variables (kSkf).
   bool apply_update(estimator::State& state, const std::vector<estimator::TypePtr>& order, const Eigen::MatrixXd& H,
                     const Eigen::VectorXd& r);

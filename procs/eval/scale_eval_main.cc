@@ -23,6 +23,7 @@
 #include "common/eval/writers.h"
 #include "common/process/arg_parser.h"
 #include "common/process/logger.h"
+#include "procs/eval/monte_carlo_args.h"
 #include "procs/eval/scale_eval.h"
 
 namespace {
@@ -56,13 +57,7 @@ int run(int argc, const char* const* argv) {
   args.add_option("vins-config", "FILE", "estimator config", "config/vins_mono.yaml");
   args.add_option("tracker-config", "FILE", "object tracker config", "config/object_tracker.yaml");
   args.add_option("scale-config", "FILE", "scale estimator config", "config/scale_estimator.yaml");
-  args.add_option("runs", "N", "Monte-Carlo runs", "3");
-  args.add_option("first-seed", "S", "simulator seed of the first run", "1");
-  args.add_option("threads", "K", "parallel runs (0 = hardware concurrency)", "0");
-  args.add_option("duration", "SECONDS", "simulate only this long (default: the config's)");
-  args.add_option("perturb-seed", "P",
-                  "perturbation seed of the VIO start for every run instead of one derived from the\n"
-                  "simulator seed (e.g. the vins config's init.perturb_seed); 0 = start at the truth");
+  eval::add_monte_carlo_args(args, "Monte-Carlo runs", "3");
   args.add_option("out", "DIR", "write summary.json and per-run seedNNN_metric_pose.csv");
   args.add_flag("quiet", "no progress bar");
   args.add_option("log-level", "LEVEL", "debug|info|warn|error", "warn");
@@ -70,29 +65,19 @@ int run(int argc, const char* const* argv) {
   set_log_name("scale-eval");
   set_log_level(parse_log_level(args.get("log-level")));
 
-  const eval::EvaluationSetup setup = eval::load_evaluation_setup(
-      args.get("sim-config"), args.get("vins-config"),
-      args.given("duration") ? std::optional<double>(args.get_double("duration")) : std::nullopt);
+  const eval::MonteCarloArgs mca = eval::read_monte_carlo_args(args);
+  const eval::EvaluationSetup setup =
+      eval::load_evaluation_setup(args.get("sim-config"), args.get("vins-config"), mca.duration_s);
   for (const std::string& m : setup.model_mismatches) log_warn("estimator model differs from the simulator: ", m);
   eval::ScaleEvalOptions options;
   options.vio = setup.vio;
   options.tracker = object_tracker_options_from_config(Config::load_file(args.get("tracker-config")));
   options.node = scale_node_options_from_config(Config::load_file(args.get("scale-config")));
 
-  const long long runs = args.get_int("runs");
-  const long long first = args.get_int("first-seed");
-  const long long threads = args.get_int("threads");
-  if (runs < 1) throw ArgError("--runs must be >= 1, got " + args.get("runs"));
-  if (first < 0) throw ArgError("--first-seed must be >= 0, got " + args.get("first-seed"));
-  if (threads < 0) throw ArgError("--threads must be >= 0, got " + args.get("threads"));
-  std::optional<uint64_t> fixed_perturb;
-  if (args.given("perturb-seed")) {
-    const long long p = args.get_int("perturb-seed");
-    if (p < 0) throw ArgError("--perturb-seed must be >= 0, got " + args.get("perturb-seed"));
-    fixed_perturb = static_cast<uint64_t>(p);
-  }
-  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int n_threads = static_cast<int>(std::min<long long>(threads > 0 ? threads : hw, runs));
+  const long long runs = mca.runs;
+  const long long first = static_cast<long long>(mca.first_seed);
+  const std::optional<uint64_t>& fixed_perturb = mca.perturb_seed;
+  const int n_threads = std::min(mca.threads, mca.runs);
   const std::string out_dir = args.get("out");
   if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
 

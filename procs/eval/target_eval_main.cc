@@ -22,6 +22,7 @@
 #include "common/process/arg_parser.h"
 #include "common/process/logger.h"
 #include "common/sim/simulator.h"
+#include "procs/eval/monte_carlo_args.h"
 
 namespace {
 
@@ -85,18 +86,12 @@ int run(int argc, const char* const* argv) {
   args.add_option("modes", "LIST", "comma-separated: ekf,skf", "ekf,skf");
   args.add_option("representations", "LIST", "comma-separated: global,local", "global,local");
   args.add_flag("no-vio-only", "skip the VIO-only row");
-  args.add_option("runs", "N", "Monte-Carlo runs per cell", "30");
-  args.add_option("first-seed", "S", "simulator seed of the first run", "1");
-  args.add_option("threads", "K", "parallel runs (0 = hardware concurrency)", "0");
-  args.add_option("duration", "SECONDS", "simulate only this long (default: the config's)");
+  eval::add_monte_carlo_args(args, "Monte-Carlo runs per cell", "30");
   args.add_option("out", "DIR", "write summary.json and summary.csv");
   args.add_option("merge", "DIRS",
                   "run nothing: tabulate the comma-separated --out folders of earlier runs together\n"
                   "(a sweep run in parts, e.g. one σ_t per run); with --out also writes the merged\n"
                   "summary.json / summary.csv");
-  args.add_option("perturb-seed", "P",
-                  "perturbation seed of the start for every run instead of one derived from the simulator\n"
-                  "seed (e.g. the vins config's init.perturb_seed, to reproduce an LCM run); 0 = the truth");
   args.add_flag("errors",
                 "with --out: also write every run's per-frame target errors with 3σ bounds\n"
                 "(DIR/errors/<mode>_<repr>_<σ_t>_seedNNN_target_in_{imu,world}.csv, the columns of\n"
@@ -111,8 +106,8 @@ int run(int argc, const char* const* argv) {
   const std::string sim_path = args.get("sim-config");
   const std::string vins_path = args.get("vins-config");
   const std::string target_path = args.get("target-config");
-  const eval::EvaluationSetup setup = eval::load_evaluation_setup(
-      sim_path, vins_path, args.given("duration") ? std::optional<double>(args.get_double("duration")) : std::nullopt);
+  const eval::MonteCarloArgs mca = eval::read_monte_carlo_args(args);
+  const eval::EvaluationSetup setup = eval::load_evaluation_setup(sim_path, vins_path, mca.duration_s);
   for (const std::string& m : setup.model_mismatches) log_warn("estimator model differs from the simulator: ", m);
   const sim::SimConfig& sim_cfg = setup.sim;
   const estimator::VioOptions& options = setup.vio;
@@ -146,16 +141,10 @@ int run(int argc, const char* const* argv) {
     }
   }
   o.vio_only = !args.flag("no-vio-only");
-  const long long runs = args.get_int("runs");
-  const long long first = args.get_int("first-seed");
-  const long long threads = args.get_int("threads");
-  if (runs < 1) throw ArgError("--runs must be >= 1, got " + args.get("runs"));
-  if (first < 0) throw ArgError("--first-seed must be >= 0, got " + args.get("first-seed"));
-  if (threads < 0) throw ArgError("--threads must be >= 0, got " + args.get("threads"));
-  o.runs = static_cast<int>(runs);
-  o.first_seed = static_cast<uint64_t>(first);
-  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  o.threads = static_cast<int>(threads > 0 ? threads : hw);
+  o.runs = mca.runs;
+  o.first_seed = mca.first_seed;
+  o.threads = mca.threads;
+  o.fixed_perturb_seed = mca.perturb_seed;
   const std::size_t n_cells =
       (o.vio_only ? 1 : 0) + o.sigmas.size() * o.modes.size() * o.representations.size();
   if (n_cells == 0) throw ArgError("nothing to run (empty --sigmas/--modes/--representations and --no-vio-only)");
@@ -163,11 +152,6 @@ int run(int argc, const char* const* argv) {
   if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
   if (args.flag("errors") && out_dir.empty()) throw ArgError("--errors needs --out DIR");
   o.keep_samples = args.flag("errors");
-  if (args.given("perturb-seed")) {
-    const long long p = args.get_int("perturb-seed");
-    if (p < 0) throw ArgError("--perturb-seed must be >= 0, got " + args.get("perturb-seed"));
-    o.fixed_perturb_seed = static_cast<uint64_t>(p);
-  }
 
   std::fprintf(stderr, "vimot-target-eval: %zu cells x %d runs on %d threads (%s, %s, %s)\n", n_cells, o.runs,
                o.threads, sim_path.c_str(), vins_path.c_str(), target_path.c_str());

@@ -21,6 +21,7 @@
 #include "common/process/arg_parser.h"
 #include "common/process/logger.h"
 #include "common/sim/simulator.h"
+#include "procs/eval/monte_carlo_args.h"
 
 namespace {
 
@@ -45,15 +46,9 @@ int run(int argc, const char* const* argv) {
                  "Exit status: 0, 2 if a run diverged, 1 on bad input.");
   args.add_option("sim-config", "FILE", "simulator scenario", "config/sim_paper.yaml");
   args.add_option("vins-config", "FILE", "estimator config (as the vins process loads it)", "config/vins.yaml");
-  args.add_option("runs", "N", "Monte-Carlo runs", "30");
-  args.add_option("first-seed", "S", "simulator seed of the first run", "1");
-  args.add_option("threads", "K", "parallel runs (0 = hardware concurrency)", "0");
-  args.add_option("duration", "SECONDS", "simulate only this long (default: the config's)");
+  eval::add_monte_carlo_args(args, "Monte-Carlo runs", "30");
   args.add_option("out", "DIR", "write per-run TUM estimate/truth and error CSV, summary.json, summary.csv");
   args.add_flag("no-perturb", "start every run exactly at the truth");
-  args.add_option("perturb-seed", "P",
-                  "perturbation seed for every run instead of one derived from the simulator seed (e.g. the "
-                  "vins config's init.perturb_seed, to reproduce an LCM run); 0 = start at the truth");
   args.add_flag("quiet", "no progress bar");
   args.add_option("log-level", "LEVEL", "debug|info|warn|error", "info");
   if (!args.parse(argc, argv)) return 0;
@@ -62,29 +57,20 @@ int run(int argc, const char* const* argv) {
 
   const std::string sim_path = args.get("sim-config");
   const std::string vins_path = args.get("vins-config");
-  const eval::EvaluationSetup setup = eval::load_evaluation_setup(
-      sim_path, vins_path, args.given("duration") ? std::optional<double>(args.get_double("duration")) : std::nullopt);
+  const eval::MonteCarloArgs mca = eval::read_monte_carlo_args(args);
+  const eval::EvaluationSetup setup = eval::load_evaluation_setup(sim_path, vins_path, mca.duration_s);
   for (const std::string& m : setup.model_mismatches) log_warn("estimator model differs from the simulator: ", m);
   const sim::SimConfig& sim_cfg = setup.sim;
   const estimator::VioOptions& options = setup.vio;
 
   eval::MonteCarloOptions mc;
-  const long long runs = args.get_int("runs");
-  const long long first = args.get_int("first-seed");
-  const long long threads = args.get_int("threads");
-  if (runs < 1) throw ArgError("--runs must be >= 1, got " + args.get("runs"));
-  if (first < 0) throw ArgError("--first-seed must be >= 0, got " + args.get("first-seed"));
-  if (threads < 0) throw ArgError("--threads must be >= 0, got " + args.get("threads"));
-  mc.runs = static_cast<int>(runs);
-  mc.first_seed = static_cast<uint64_t>(first);
-  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  mc.threads = std::min(static_cast<int>(threads > 0 ? threads : hw), mc.runs);
+  mc.runs = mca.runs;
+  mc.first_seed = mca.first_seed;
+  mc.threads = std::min(mca.threads, mc.runs);
   mc.perturb = !args.flag("no-perturb");
-  if (args.given("perturb-seed")) {
-    const long long p = args.get_int("perturb-seed");
-    if (p < 0) throw ArgError("--perturb-seed must be >= 0, got " + args.get("perturb-seed"));
-    if (p == 0) mc.perturb = false;
-    mc.fixed_perturb_seed = static_cast<uint64_t>(p);
+  if (mca.perturb_seed) {
+    if (*mca.perturb_seed == 0) mc.perturb = false;
+    mc.fixed_perturb_seed = *mca.perturb_seed;
   }
   const std::string out_dir = args.get("out");
   mc.keep_samples = !out_dir.empty();

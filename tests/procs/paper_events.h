@@ -2,6 +2,8 @@
 // The paper scenario's event stream for the process-logic tests.
 
 #include <string>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "common/config/config.h"
@@ -21,6 +23,26 @@ inline std::vector<sim::SimEvent> simulate(double duration) {
   std::vector<sim::SimEvent> events;
   s.run([&](const sim::SimEvent& e) { events.push_back(e); });
   return events;
+}
+
+/// Every camera frame but the first moved before the last 5 IMU samples up
+/// to its time, as if it arrived early on the network (the first stays after
+/// the ground truth that initialises the filter).
+inline std::vector<sim::SimEvent> frames_early(std::vector<sim::SimEvent> early) {
+  bool first_frame = true;
+  for (std::size_t i = 0; i < early.size(); ++i) {
+    if (!std::holds_alternative<CameraFrame>(early[i])) continue;
+    if (std::exchange(first_frame, false)) continue;
+    std::size_t j = i;
+    int imu_passed = 0;
+    while (j > 0 && imu_passed < 5) {
+      if (std::holds_alternative<ImuData>(early[j - 1])) ++imu_passed;
+      if (std::holds_alternative<CameraFrame>(early[j - 1])) break;
+      std::swap(early[j], early[j - 1]);
+      --j;
+    }
+  }
+  return early;
 }
 
 }  // namespace vimot

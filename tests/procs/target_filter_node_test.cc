@@ -86,25 +86,6 @@ double max_nav_difference(const std::vector<NavState>& a, const std::vector<NavS
   return d;
 }
 
-// Every camera frame (but the first) moved before the last 5 IMU samples up
-// to its time, as in vins_node_test.
-std::vector<sim::SimEvent> frames_early(std::vector<sim::SimEvent> early) {
-  bool first_frame = true;
-  for (std::size_t i = 0; i < early.size(); ++i) {
-    if (!std::holds_alternative<CameraFrame>(early[i])) continue;
-    if (std::exchange(first_frame, false)) continue;
-    std::size_t j = i;
-    int imu_passed = 0;
-    while (j > 0 && imu_passed < 5) {
-      if (std::holds_alternative<ImuData>(early[j - 1])) ++imu_passed;
-      if (std::holds_alternative<CameraFrame>(early[j - 1])) break;
-      std::swap(early[j], early[j - 1]);
-      --j;
-    }
-  }
-  return early;
-}
-
 }  // namespace
 
 TEST_CASE("target filter node under SKF publishes exactly the VIO-only robot states", "[target_filter]") {

@@ -68,21 +68,7 @@ TEST_CASE("vins node output does not depend on message interleaving", "[vins]") 
   // time (it arrives early on the network): it must wait for them.
   // (The first frame stays after the ground truth that initialises the
   // filter: a frame before initialisation is rightly dropped.)
-  std::vector<sim::SimEvent> early = events;
-  bool first_frame = true;
-  for (std::size_t i = 0; i < early.size(); ++i) {
-    if (!std::holds_alternative<CameraFrame>(early[i])) continue;
-    if (std::exchange(first_frame, false)) continue;
-    std::size_t j = i;
-    int imu_passed = 0;
-    while (j > 0 && imu_passed < 5) {
-      if (std::holds_alternative<ImuData>(early[j - 1])) ++imu_passed;
-      if (std::holds_alternative<CameraFrame>(early[j - 1])) break;
-      std::swap(early[j], early[j - 1]);
-      --j;
-    }
-  }
-  const Outputs reordered = run_node(early);
+  const Outputs reordered = run_node(frames_early(events));
   CHECK(same_states(in_order.updated, reordered.updated));
 }
 

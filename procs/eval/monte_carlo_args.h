@@ -1,0 +1,32 @@
+#pragma once
+// The command-line options every Monte-Carlo evaluation tool shares
+// (vimot-vio-eval, vimot-target-eval, vimot-scale-eval): --runs,
+// --first-seed, --threads, --duration, --perturb-seed, declared and checked
+// in one place.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "common/process/arg_parser.h"
+
+namespace vimot {
+namespace eval {
+
+/// Declares the options; `runs_help` and `default_runs` differ per tool.
+void add_monte_carlo_args(ArgParser& args, const std::string& runs_help, const std::string& default_runs);
+
+struct MonteCarloArgs {
+  int runs{1};
+  uint64_t first_seed{1};
+  int threads{1};                        // --threads 0 resolved to the hardware concurrency
+  std::optional<double> duration_s;      // --duration
+  std::optional<uint64_t> perturb_seed;  // --perturb-seed (0 = start at the truth)
+};
+
+/// Reads and checks them after ArgParser::parse. Throws ArgError naming the
+/// option on a bad value.
+MonteCarloArgs read_monte_carlo_args(const ArgParser& args);
+
+}  // namespace eval
+}  // namespace vimot
