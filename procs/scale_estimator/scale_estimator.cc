@@ -28,6 +28,7 @@ ScaleEstimatorOptions ScaleEstimatorOptions::from_config(const Config& cfg,
                                                          const std::string& section) {
   ScaleEstimatorOptions o;
   static const char* kKeys[] = {"window_size",   "min_observations",      "derivative_order",
+                                "motion_lowpass_s", "motion_highpass_s",
                                 "epsilon_t1",    "rho_t1",                "rho_t2",
                                 "relative_condition_i", "require_positive_scale",
                                 "max_gap_s",     "quat_norm_tolerance"};
@@ -41,6 +42,8 @@ ScaleEstimatorOptions ScaleEstimatorOptions::from_config(const Config& cfg,
   read(cfg, s + "window_size", &o.window_size);
   read(cfg, s + "min_observations", &o.min_observations);
   read(cfg, s + "derivative_order", &o.derivative_order);
+  read(cfg, s + "motion_lowpass_s", &o.motion_lowpass_s);
+  read(cfg, s + "motion_highpass_s", &o.motion_highpass_s);
   read(cfg, s + "epsilon_t1", &o.epsilon_t1);
   read(cfg, s + "rho_t1", &o.rho_t1);
   read(cfg, s + "rho_t2", &o.rho_t2);
@@ -61,6 +64,11 @@ void ScaleEstimatorOptions::validate() const {
     throw std::invalid_argument(key + " " + what);
   };
   if (derivative_order != 1 && derivative_order != 2) fail("derivative_order", "must be 1 or 2");
+  if (!(motion_lowpass_s >= 0.0) || !std::isfinite(motion_lowpass_s)) fail("motion_lowpass_s", "must be finite and >= 0");
+  if (!(motion_highpass_s >= 0.0) || !std::isfinite(motion_highpass_s))
+    fail("motion_highpass_s", "must be finite and >= 0");
+  if (motion_highpass_s > 0.0 && !(motion_highpass_s > motion_lowpass_s))
+    fail("motion_highpass_s", "must exceed motion_lowpass_s (else the band is empty)");
   if (min_observations < 4) fail("min_observations", "must be >= 4");
   if (window_size < min_observations) fail("window_size", "must be >= min_observations");
   if (!(epsilon_t1 >= 0.0) || !std::isfinite(epsilon_t1)) fail("epsilon_t1", "must be finite and >= 0");
@@ -142,6 +150,35 @@ std::vector<Eigen::Vector3d> central_difference(const std::vector<int64_t>& utim
       wp = 2.0 / (h2 * h);
     }
     out.push_back(wm * values[k - 1] + w0 * values[k] + wp * values[k + 1]);
+  }
+  return out;
+}
+
+std::vector<Eigen::Vector3d> band_pass(const std::vector<int64_t>& utimes, const std::vector<Eigen::Vector3d>& m,
+                                       double lowpass_s, double highpass_s) {
+  if (utimes.size() != m.size()) throw std::invalid_argument("band_pass: utimes and samples differ in size");
+  if (!(lowpass_s >= 0.0) || !(highpass_s >= 0.0)) throw std::invalid_argument("band_pass: negative width");
+  if (lowpass_s == 0.0 && highpass_s == 0.0) return m;
+  // Half widths in µs; integer time arithmetic, as central_difference.
+  const auto half_us = [](double w) { return static_cast<int64_t>(std::llround(0.5e6 * w)); };
+  const int64_t hl = half_us(lowpass_s), hh = half_us(highpass_s), reach = std::max(hl, hh);
+  // Running sum of m over [t_k - h, t_k + h] with two monotone indices.
+  struct Box {
+    int64_t half;
+    size_t lo{0}, hi{0};
+    Eigen::Vector3d sum{Eigen::Vector3d::Zero()};
+    Eigen::Vector3d mean_at(size_t k, const std::vector<int64_t>& t, const std::vector<Eigen::Vector3d>& x) {
+      while (hi < t.size() && t[hi] <= t[k] + half) sum += x[hi++];
+      while (t[lo] < t[k] - half) sum -= x[lo++];
+      return sum / static_cast<double>(hi - lo);
+    }
+  };
+  Box low{hl}, high{hh};
+  std::vector<Eigen::Vector3d> out;
+  for (size_t k = 0; k < m.size(); ++k) {
+    if (utimes[k] - utimes.front() < reach || utimes.back() - utimes[k] < reach) continue;
+    const Eigen::Vector3d smooth = hl > 0 ? low.mean_at(k, utimes, m) : m[k];
+    out.push_back(hh > 0 ? Eigen::Vector3d(smooth - high.mean_at(k, utimes, m)) : smooth);
   }
   return out;
 }
@@ -287,8 +324,12 @@ ScaleResult ScaleEstimator::update() {
       p_c.push_back(o.p_CinG);
       p_d.push_back(o.p_d_in_G());  // Eq. 5
     }
-    const auto m_c = central_difference(t, p_c, options_.derivative_order);  // Eq. 8-9
-    const auto m_d = central_difference(t, p_d, options_.derivative_order);
+    // Eq. 8-9 at the interior samples t[1 .. N-2], then the band-pass.
+    const std::vector<int64_t> t_motion(t.begin() + 1, t.end() - 1);
+    const auto m_c = band_pass(t_motion, central_difference(t, p_c, options_.derivative_order),
+                               options_.motion_lowpass_s, options_.motion_highpass_s);
+    const auto m_d = band_pass(t_motion, central_difference(t, p_d, options_.derivative_order),
+                               options_.motion_lowpass_s, options_.motion_highpass_s);
     r = estimate_scale(m_c, m_d, options_);
   }
   r.num_observations = N;

@@ -44,6 +44,16 @@ struct ScaleEstimatorOptions {
   int min_observations{200};
   /// n of Eq. 8: 1 = velocity (paper's choice), 2 = acceleration.
   int derivative_order{1};
+  /// Band-pass of the motion samples, the same for m_c and m_d (not in the
+  /// paper; 0 = off, the paper's estimator): m ← box_L(m) − box_H(m), box_w
+  /// the centred moving average over w seconds. The high-pass removes the
+  /// slow motion band where a moving object covaries with the camera over
+  /// a finite window (Eq. 15's bias), the low-pass the frame-rate noise.
+  /// Eq. 8 stays exact: the filter is linear. Samples whose box_H (or
+  /// box_L) window does not fit in the window are dropped. See
+  /// docs/scale_estimator.md ("Band-pass").
+  double motion_lowpass_s{0.0};
+  double motion_highpass_s{0.0};
   /// (i) f(s*) <= epsilon_t1. Units for n = 1: (m/s)^4; n = 2: (m/s^2)^4.
   double epsilon_t1{1e-3};
   /// (ii) sum_ij Cov^2(m_c^i, m_c^j) >= rho_t1, same units as epsilon_t1.
@@ -67,7 +77,8 @@ struct ScaleEstimatorOptions {
 
   /// Keys of `section` (every key optional, defaults as above; an unknown
   /// key in the section is an error): window_size, min_observations,
-  /// derivative_order, epsilon_t1, rho_t1, rho_t2, relative_condition_i,
+  /// derivative_order, motion_lowpass_s, motion_highpass_s, epsilon_t1,
+  /// rho_t1, rho_t2, relative_condition_i,
   /// require_positive_scale, max_gap_s, quat_norm_tolerance.
   /// Throws ConfigError naming the offending key.
   static ScaleEstimatorOptions from_config(const Config& cfg,
@@ -144,7 +155,7 @@ struct ScaleResult {
   /// (only if require_positive_scale). 0 with kInsufficientData.
   int failed_condition{0};
   int num_observations{0};     // pose observations in the window
-  int num_motion_samples{0};   // m_c / m_d samples used (num_observations - 2)
+  int num_motion_samples{0};   // m_c / m_d samples used (num_observations - 2, fewer with the band-pass)
   Eigen::Matrix3d cov_dc{Eigen::Matrix3d::Zero()};  // D_ij = Cov(m_d^i, m_c^j)
   Eigen::Matrix3d cov_cc{Eigen::Matrix3d::Zero()};  // C_ij = Cov(m_c^i, m_c^j)
 };
@@ -157,6 +168,14 @@ struct ScaleResult {
 std::vector<Eigen::Vector3d> central_difference(const std::vector<int64_t>& utimes,
                                                 const std::vector<Eigen::Vector3d>& values,
                                                 int n);
+
+/// box_L(m) − box_H(m) (see ScaleEstimatorOptions::motion_*_s) at the
+/// samples k whose centred windows [t_k ∓ w/2] lie within [t_0, t_end];
+/// lowpass_s = 0 keeps m_k, highpass_s = 0 subtracts nothing. A box
+/// average includes the samples with |t_j − t_k| <= w/2. Throws
+/// std::invalid_argument on a size mismatch or a negative width.
+std::vector<Eigen::Vector3d> band_pass(const std::vector<int64_t>& utimes, const std::vector<Eigen::Vector3d>& m,
+                                       double lowpass_s, double highpass_s);
 
 /// The core of Eq. 12-14 and 19 on given motion samples (equal sizes >= 2).
 /// Fills everything except utime and num_observations (set to m_c.size()+2).

@@ -146,6 +146,79 @@ TEST_CASE("scale_core: non-uniform central differences (Eq. 8-9)", "[scale]") {
   CHECK_THROWS_AS(central_difference(tu, xu, 3), std::invalid_argument);
 }
 
+// Samples 1 s apart, x = k^2, y = k, z = (-1)^k. Box of 2 s = 3 samples,
+// box of 4 s = 5 samples; only k = 2..4 have the 4 s box inside [0, 6].
+// By hand: mean of k^2 over k-1..k+1 is k^2 + 2/3, over k-2..k+2 it is
+// k^2 + 2, so x -> -4/3; a linear y is unchanged by both boxes -> 0;
+// z: the 3-sample mean of (-1)^j is -(-1)^k / 3, the 5-sample mean
+// (-1)^k / 5, so z -> -(-1)^k 8/15.
+TEST_CASE("scale_core: band-pass of the motion samples against hand values", "[scale]") {
+  std::vector<int64_t> t;
+  std::vector<Eigen::Vector3d> m;
+  for (int k = 0; k <= 6; ++k) {
+    t.push_back(5'000'000'000 + 1'000'000 * k);
+    m.emplace_back(k * k, k, k % 2 == 0 ? 1.0 : -1.0);
+  }
+  const std::vector<Eigen::Vector3d> out = band_pass(t, m, 2.0, 4.0);
+  REQUIRE(out.size() == 3);
+  for (int i = 0; i < 3; ++i) {
+    const int k = i + 2;
+    CHECK_THAT(out[i].x(), WithinAbs(-4.0 / 3.0, 1e-12));
+    CHECK_THAT(out[i].y(), WithinAbs(0.0, 1e-12));
+    CHECK_THAT(out[i].z(), WithinAbs((k % 2 == 0 ? -1.0 : 1.0) * 8.0 / 15.0, 1e-12));
+  }
+  // High-pass only: m_k minus the 5-sample mean; low-pass only: the 3-sample
+  // mean at k = 1..5; neither: unchanged.
+  const auto high = band_pass(t, m, 0.0, 4.0);
+  REQUIRE(high.size() == 3);
+  CHECK_THAT(high[0].x(), WithinAbs(-2.0, 1e-12));
+  const auto low = band_pass(t, m, 2.0, 0.0);
+  REQUIRE(low.size() == 5);
+  CHECK_THAT(low[0].x(), WithinAbs(1.0 + 2.0 / 3.0, 1e-12));
+  CHECK(band_pass(t, m, 0.0, 0.0) == m);
+  CHECK_THROWS_AS(band_pass(t, std::vector<Eigen::Vector3d>(3), 1.0, 2.0), std::invalid_argument);
+  CHECK_THROWS_AS(band_pass(t, m, -1.0, 2.0), std::invalid_argument);
+}
+
+// Eq. 8 stays exact under the band-pass: it is linear, so with the object
+// at rest (m_o = 0) s* is still exactly s, and a slow object motion that
+// covaries with a slow camera term is filtered out. Camera: a slow 0.1 Hz
+// swing plus a 1 Hz shake; object: 0.1 Hz in phase with the swing. The
+// paper's estimator sees Cov(m_o, m_c) != 0 (Eq. 15) and is biased; the
+// band-pass 0.3 s / 2.5 s keeps the 1 Hz shake only.
+TEST_CASE("scale_core: the band-pass removes a slow object-camera covariance", "[scale]") {
+  const double s_true = 2.0;
+  auto run = [&](double lowpass, double highpass, double object_amplitude) {
+    ScaleEstimatorOptions o;
+    o.window_size = o.min_observations = 400;  // 20 s at 20 Hz
+    o.motion_lowpass_s = lowpass;
+    o.motion_highpass_s = highpass;
+    ScaleEstimator est(o);
+    ScaleResult r;
+    for (int k = 0; k < 400; ++k) {
+      const double t = 0.05 * k;
+      const Eigen::Vector3d p_C(0.3 * std::sin(2 * M_PI * 0.1 * t) + 0.05 * std::sin(2 * M_PI * 1.0 * t),
+                                0.05 * std::cos(2 * M_PI * 1.0 * t), 0.0);
+      const Eigen::Vector3d p_O(3.0 + object_amplitude * std::sin(2 * M_PI * 0.1 * t), 0.0, 0.0);
+      ScaleObservation obs = ScaleObservation::from_rotations(1'000'000 + 50'000 * k, Eigen::Matrix3d::Identity(),
+                                                              p_C, Eigen::Matrix3d::Identity(), (p_O - p_C) / s_true);
+      REQUIRE(is_added(est.add(obs)));
+      r = est.update();
+    }
+    REQUIRE(r.status != ScaleStatus::kInsufficientData);
+    return r.scale / s_true - 1.0;
+  };
+  // Object at rest: exact with and without the band-pass.
+  CHECK_THAT(run(0.0, 0.0, 0.0), WithinAbs(0.0, 1e-9));
+  CHECK_THAT(run(0.3, 2.5, 0.0), WithinAbs(0.0, 1e-9));
+  // Object swinging with the camera's slow term.
+  const double paper = run(0.0, 0.0, 0.2);
+  const double band = run(0.3, 2.5, 0.2);
+  INFO("paper " << paper << ", band-pass " << band);
+  CHECK(std::abs(paper) > 0.1);
+  CHECK(std::abs(band) < 0.01);
+}
+
 TEST_CASE("scale_core: pipeline on 5 hand-made observations, rotated camera", "[scale]") {
   // Same utimes as above. Camera: p_CinG = (t^2, 0, 0), R_CtoG = Rz(90 deg)
   // constant. Object offset in the world chosen as p_d^w = (1 - t^2/2, 0, 1),
@@ -302,6 +375,8 @@ scale_estimator:
   window_size: 150
   min_observations: 100
   derivative_order: 2
+  motion_lowpass_s: 0.2
+  motion_highpass_s: 3.0
   epsilon_t1: 0.01
   rho_t1: 0.5
   rho_t2: 0.02
@@ -315,6 +390,8 @@ scale_estimator:
   CHECK(o.window_size == 150);
   CHECK(o.min_observations == 100);
   CHECK(o.derivative_order == 2);
+  CHECK(o.motion_lowpass_s == 0.2);
+  CHECK(o.motion_highpass_s == 3.0);
   CHECK(o.epsilon_t1 == 0.01);
   CHECK(o.rho_t1 == 0.5);
   CHECK(o.rho_t2 == 0.02);
@@ -327,12 +404,20 @@ scale_estimator:
   const ScaleEstimatorOptions d = ScaleEstimatorOptions::from_config(Config::from_string("other: 1"));
   CHECK(d.window_size == 200);
   CHECK(d.derivative_order == 1);
+  CHECK(d.motion_lowpass_s == 0.0);  // the paper's estimator
+  CHECK(d.motion_highpass_s == 0.0);
 
   CHECK_THROWS_AS(ScaleEstimatorOptions::from_config(
                       Config::from_string("scale_estimator:\n  derivative_order: 3\n")),
                   ConfigError);
   CHECK_THROWS_AS(ScaleEstimatorOptions::from_config(
                       Config::from_string("scale_estimator:\n  window_size: 100\n")),  // < min 200
+                  ConfigError);
+  CHECK_THROWS_AS(ScaleEstimatorOptions::from_config(Config::from_string(
+                      "scale_estimator:\n  motion_lowpass_s: 1.0\n  motion_highpass_s: 0.5\n")),  // empty band
+                  ConfigError);
+  CHECK_THROWS_AS(ScaleEstimatorOptions::from_config(
+                      Config::from_string("scale_estimator:\n  motion_lowpass_s: -0.1\n")),
                   ConfigError);
   CHECK_THROWS_AS(ScaleEstimatorOptions::from_config(
                       Config::from_string("scale_estimator:\n  rho_t1x: 1\n")),  // typo
