@@ -33,7 +33,7 @@ namespace target {
 struct ObjectPoseFilterOptions {
   /// Random walk of v_OinO (m/s²/√Hz) and w_OinO (rad/s²/√Hz), per axis of O.
   /// Isotropic: the tracker's O has no relation to the object's own axes.
-  TargetNoise noise{TargetNoise::isotropic(0.3, 0.3)};
+  TargetNoise noise{TargetNoise::isotropic(0.3, 1.0)};
   /// Position σ in the camera frame at distance d = |p_OinC|: k_lateral d on
   /// x, y (an angular error, rad) and k_depth d² along z (depth from a
   /// fixed-size object's image: σ_d ∝ d²).

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "common/config/config.h"
 #include "common/math/quat.h"
 #include "procs/scale_estimator/scale_node.h"
 #include "scale_scenarios.h"
@@ -299,4 +300,29 @@ TEST_CASE("scale_node: the object filter's state and prediction per metric pose,
   CHECK(node.stats().new_tracks == 1);
   CHECK(!node.filter().initialized());
   CHECK(states.size() == states_before);
+}
+
+TEST_CASE("scale_node: object_filter options from the config, unknown keys and bad values refused", "[scale]") {
+  ScaleNodeOptions o;
+  object_filter_options_from_config(Config::from_string("object_filter:\n  sigma_v: 0.2\n  sigma_w: 0.7\n"
+                                                        "  k_depth: 0.01\n  sigma_theta: [0.01, 0.02, 0.03]\n"
+                                                        "  max_consecutive_rejections: 3\n  prediction_horizon_s: 1.5\n"),
+                                    &o);
+  CHECK(o.filter.noise.sigma_v == Eigen::Vector3d::Constant(0.2));
+  CHECK(o.filter.noise.sigma_w == Eigen::Vector3d::Constant(0.7));
+  CHECK(o.filter.k_depth == 0.01);
+  CHECK(o.filter.k_lateral == target::ObjectPoseFilterOptions().k_lateral);
+  CHECK(o.filter.sigma_theta_C == Eigen::Vector3d(0.01, 0.02, 0.03));
+  CHECK(o.filter.max_consecutive_rejections == 3);
+  CHECK(o.prediction_horizon_s == 1.5);
+  ScaleNodeOptions d;
+  object_filter_options_from_config(Config::from_string("node:\n  max_pending: 3\n"), &d);  // no section: defaults
+  CHECK(d.prediction_horizon_s == 0.5);
+  CHECK_THROWS_AS(object_filter_options_from_config(Config::from_string("object_filter:\n  sigma_x: 1\n"), &d),
+                  ConfigError);
+  CHECK_THROWS_AS(object_filter_options_from_config(Config::from_string("object_filter:\n  k_depth: -1\n"), &d),
+                  ConfigError);
+  CHECK_THROWS_AS(
+      object_filter_options_from_config(Config::from_string("object_filter:\n  prediction_horizon_s: -1\n"), &d),
+      ConfigError);
 }
