@@ -14,11 +14,12 @@
 // gated by χ²: rᵀ S⁻¹ r < chi2_multiplier · χ²_0.95(6).
 //
 // The first pose initialises the filter (v = w = 0 with σ init_sigma_v,
-// init_sigma_w). A pose after more than max_gap_s without an accepted one,
-// or the max_consecutive_rejections-th gated pose in a row, re-initialises
-// it: a constant-velocity extrapolation over a long gap, or a filter that
-// rejects everything, would otherwise never recover. Non-finite input and a
-// utime not after the filter's are refused and counted; nothing else changes.
+// init_sigma_w). A pose more than max_gap_s after the filter's time (the
+// last pose, gated or not), or the max_consecutive_rejections-th gated pose
+// in a row, re-initialises it: a constant-velocity extrapolation over a long
+// gap, or a filter that rejects everything, would otherwise never recover.
+// Non-finite input and a utime not after the filter's are refused and
+// counted; nothing else changes.
 
 #include <cstdint>
 
@@ -86,7 +87,7 @@ struct ObjectPoseFilterStats {
   int64_t updates{0};
   int64_t outliers{0};
   int64_t reinitializations{0};      // after max_consecutive_rejections outliers in a row
-  int64_t gap_reinitializations{0};  // after more than max_gap_s without an accepted pose
+  int64_t gap_reinitializations{0};  // after a gap above max_gap_s
   int64_t duplicates{0};
   int64_t backwards{0};
   int64_t invalid{0};

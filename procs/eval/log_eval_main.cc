@@ -206,9 +206,12 @@ int run(int argc, const char* const* argv) {
                    {"filtered position std x [m]", f.filtered_position_error.std(0), o.filtered_position_error.std(0)},
                    {"filtered position std y [m]", f.filtered_position_error.std(1), o.filtered_position_error.std(1)},
                    {"filtered position std z [m]", f.filtered_position_error.std(2), o.filtered_position_error.std(2)},
-                   {"filtered yaw std [rad]", f.filtered_orientation_error.std(0), o.filtered_orientation_error.std(0)},
-                   {"filtered pitch std [rad]", f.filtered_orientation_error.std(1), o.filtered_orientation_error.std(1)},
-                   {"filtered roll std [rad]", f.filtered_orientation_error.std(2), o.filtered_orientation_error.std(2)},
+                   {"filtered yaw std [rad]", f.filtered_orientation_error.std(0),
+                    o.filtered_orientation_error.std(0)},
+                   {"filtered pitch std [rad]", f.filtered_orientation_error.std(1),
+                    o.filtered_orientation_error.std(1)},
+                   {"filtered roll std [rad]", f.filtered_orientation_error.std(2),
+                    o.filtered_orientation_error.std(2)},
                    {"filtered NEES position", f.filtered_nees_position, o.filtered_nees_position},
                    {"filtered NEES orientation", f.filtered_nees_orientation, o.filtered_nees_orientation}});
   }

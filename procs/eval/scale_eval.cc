@@ -263,7 +263,8 @@ void write_scale_run_json(JsonWriter& j, const ScaleRunResult& r) {
   j.field("filtered_nees_orientation", f.filtered_nees_orientation);
   j.key("vio");
   write_summary_json(j, r.vio);
-  j.field("tracker_ms_mean", r.tracker_ms_mean).field("filter_us_mean", r.filter_us_mean).field("vio_diverged", r.vio_diverged).field("wall_s", r.wall_s);
+  j.field("tracker_ms_mean", r.tracker_ms_mean).field("filter_us_mean", r.filter_us_mean);
+  j.field("vio_diverged", r.vio_diverged).field("wall_s", r.wall_s);
   j.key("tracks").begin_array();
   for (const TrackTruth& t : r.tracks) {
     j.begin_object();

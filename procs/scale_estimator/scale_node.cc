@@ -26,6 +26,10 @@ void ScaleNodeOptions::validate() const {
   if (!(estimate_period_s >= 0.0)) {
     throw std::invalid_argument("estimate_period_s must be >= 0, got " + std::to_string(estimate_period_s));
   }
+  validate_object_filter();
+}
+
+void ScaleNodeOptions::validate_object_filter() const {
   filter.validate();
   if (!(prediction_horizon_s >= 0.0) || !std::isfinite(prediction_horizon_s)) {
     throw std::invalid_argument("prediction_horizon_s must be finite and >= 0");
@@ -55,10 +59,7 @@ void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* opti
   f.max_gap_s = sec.get_or<double>("max_gap_s", f.max_gap_s);
   options->prediction_horizon_s = sec.get_or<double>("prediction_horizon_s", options->prediction_horizon_s);
   try {
-    f.validate();
-    if (!(options->prediction_horizon_s >= 0.0) || !std::isfinite(options->prediction_horizon_s)) {
-      throw std::invalid_argument("prediction_horizon_s must be finite and >= 0");
-    }
+    options->validate_object_filter();
   } catch (const std::invalid_argument& e) {
     cfg.fail("object_filter", e.what());
   }

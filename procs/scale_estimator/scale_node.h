@@ -71,6 +71,8 @@ struct ScaleNodeOptions {
 
   /// Throws std::invalid_argument naming the bad option.
   void validate() const;
+  /// The part of validate() for filter and prediction_horizon_s.
+  void validate_object_filter() const;
 };
 
 /// From a config/scale_estimator.yaml: `scale_estimator:` (the core's

@@ -304,10 +304,10 @@ TEST_CASE("scale_node: the object filter's state and prediction per metric pose,
 
 TEST_CASE("scale_node: object_filter options from the config, unknown keys and bad values refused", "[scale]") {
   ScaleNodeOptions o;
-  object_filter_options_from_config(Config::from_string("object_filter:\n  sigma_v: 0.2\n  sigma_w: 0.7\n"
-                                                        "  k_depth: 0.01\n  sigma_theta: [0.01, 0.02, 0.03]\n"
-                                                        "  max_consecutive_rejections: 3\n  prediction_horizon_s: 1.5\n"),
-                                    &o);
+  const Config cfg = Config::from_string(
+      "object_filter:\n  sigma_v: 0.2\n  sigma_w: 0.7\n  k_depth: 0.01\n  sigma_theta: [0.01, 0.02, 0.03]\n"
+      "  max_consecutive_rejections: 3\n  prediction_horizon_s: 1.5\n");
+  object_filter_options_from_config(cfg, &o);
   CHECK(o.filter.noise.sigma_v == Eigen::Vector3d::Constant(0.2));
   CHECK(o.filter.noise.sigma_w == Eigen::Vector3d::Constant(0.7));
   CHECK(o.filter.k_depth == 0.01);
