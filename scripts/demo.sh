@@ -9,8 +9,8 @@
 #  - default: sheriff_configs/sim_demo.pmd (simulator, vins, the target
 #    filter, lcm-logger): VIO and target accuracy.
 #  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
-#    scale estimator, lcm-logger): VIO accuracy, scale error and the metric
-#    object pose error in the world.
+#    scale estimator, lcm-logger): VIO accuracy, scale error, the metric
+#    object pose error in the world and that of the object motion filter.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
@@ -87,13 +87,13 @@ perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VI
   --compare "$out/offline/summary.json" | sed 's/^/   /'
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
 if [ $pipeline = mono ]; then
-  echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC vs GROUND_TRUTH), and the offline run:"
+  echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run:"
   "$VIMOT_BIN/vimot-scale-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
     --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --tracker-config "$VIMOT_CONFIG/object_tracker.yaml" \
     --scale-config "$VIMOT_CONFIG/scale_estimator.yaml" --runs 1 --first-seed "$VIMOT_SEED" \
     --perturb-seed "${perturb_seed:-0}" --out "$out/offline_scale" --quiet > "$out/offline_scale.txt" 2>&1 || true
   "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --scale-truth "$out/offline_scale/summary.json" \
-    | grep -E '^(scale|metric|compare|  (scale|accepted|last|object))' | sed 's/^/   /'
+    | grep -E '^(scale|metric|filtered|compare|  (scale|accepted|last|object|filtered))' | sed 's/^/   /'
   echo "   (offline run: $out/offline_scale.txt)"
   echo "== log: $VIMOT_LOG"
   echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"

@@ -55,6 +55,7 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   const bool scale_on = !options.scale_channel.empty();
   std::vector<scale::ScaleResult> estimates;
   std::vector<scale::ObjectPoseInWorld> metric_poses;
+  std::vector<TargetStateEstimate> object_states;
   std::map<int64_t, GroundTruth> target_truths;  // for the metric poses
   auto malformed = [&r](int64_t* counter, const lcm::LogEvent& ev, const std::string& why) {
     ++*counter;
@@ -109,6 +110,17 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
       } catch (const std::invalid_argument& e) {
         malformed(&r.malformed_scale, *ev, e.what());
       }
+    } else if (scale_on && !options.object_state_channel.empty() && ev->channel == options.object_state_channel) {
+      target_state_t msg;
+      if (!decode(*ev, &msg, &why)) {
+        malformed(&r.malformed_scale, *ev, why);
+        continue;
+      }
+      try {
+        object_states.push_back(from_lcm(msg));
+      } catch (const std::invalid_argument& e) {
+        malformed(&r.malformed_scale, *ev, e.what());
+      }
     } else if (ev->channel == options.truth_channel) {
       ground_truth_t msg;
       if (!decode(*ev, &msg, &why)) {
@@ -140,7 +152,9 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
     ScaleFigureBuilder figures;
     for (const TrackTruth& t : options.tracks) figures.start_track(t.start_utime, t.truth);
     for (const scale::ScaleResult& e : estimates) figures.add_estimate(e.utime, e.scale, e.accepted);
+    std::map<int64_t, double> held_scales;  // of the metric pose of each frame
     for (const scale::ObjectPoseInWorld& p : metric_poses) {
+      held_scales[p.utime] = p.scale;
       const auto it = target_truths.find(p.utime);
       if (it == target_truths.end()) {
         ++r.metric_without_truth;
@@ -148,6 +162,15 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
       }
       figures.add_metric_pose(p.utime, p.scale, p.R_OtoG, p.p_OinG, quat_to_rot(it->second.q_GtoT).transpose(),
                               it->second.p_TinG);
+    }
+    for (const TargetStateEstimate& s : object_states) {
+      const auto it = target_truths.find(s.utime);
+      const auto scale = held_scales.find(s.utime);
+      if (it == target_truths.end() || scale == held_scales.end()) {
+        ++r.object_states_without_truth;
+        continue;
+      }
+      figures.add_filtered_pose(s, scale->second, quat_to_rot(it->second.q_GtoT).transpose(), it->second.p_TinG);
     }
     r.scale = figures.figures();
   }

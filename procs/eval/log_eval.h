@@ -28,6 +28,7 @@ struct LogEvalOptions {
   // tracker's initialisation, which the log does not carry).
   std::string scale_channel;   // empty: no scale evaluation
   std::string metric_channel;
+  std::string object_state_channel;  // target_state_t of the object motion filter; empty: none
   std::vector<TrackTruth> tracks;
 };
 
@@ -46,8 +47,9 @@ struct LogEvalResult {
   TargetMatchCounts target_counts;
   int64_t malformed_targets{0};
   ScaleFigures scale;
-  int64_t malformed_scale{0};   // on scale_channel or metric_channel
+  int64_t malformed_scale{0};   // on scale_channel, metric_channel or object_state_channel
   int64_t metric_without_truth{0};
+  int64_t object_states_without_truth{0};
 };
 
 /// Index in "cells" of the first target-filter cell (not VIO-only) of a

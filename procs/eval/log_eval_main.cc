@@ -41,12 +41,14 @@ int run(int argc, const char* const* argv) {
                   "with --target-channel: print the relative difference of the target figures to a\n"
                   "one-run vimot-target-eval summary.json (its first target-filter cell)");
   args.add_option("scale-truth", "SUMMARY_JSON",
-                  "evaluate the monocular scale pipeline too: SCALE_ESTIMATE and OBJECT_POSE_METRIC\n"
+                  "evaluate the monocular scale pipeline too: SCALE_ESTIMATE, OBJECT_POSE_METRIC and OBJECT_STATE\n"
                   "against the truth of the object tracks in this one-run vimot-scale-eval summary.json\n"
                   "of the same seed (the log cannot define the tracker's object frame), and print the\n"
                   "relative difference to that run's figures");
   args.add_option("scale-channel", "CHANNEL", "scale_estimate_t channel", "SCALE_ESTIMATE");
   args.add_option("metric-channel", "CHANNEL", "metric_object_pose_t channel", "OBJECT_POSE_METRIC");
+  args.add_option("object-state-channel", "CHANNEL", "target_state_t channel of the object motion filter",
+                  "OBJECT_STATE");
   args.add_option("json", "FILE", "write the summary as JSON (object \"summary\", as vimot-vio-eval's)");
   args.add_option("csv", "FILE", "write the per-sample errors with 3-sigma bounds (as vimot-vio-eval's)");
   args.add_option("compare", "SUMMARY_JSON", "print the relative difference to this summary (e.g. an offline run)");
@@ -61,6 +63,7 @@ int run(int argc, const char* const* argv) {
   if (args.given("scale-truth")) {
     opt.scale_channel = args.get("scale-channel");
     opt.metric_channel = args.get("metric-channel");
+    opt.object_state_channel = args.get("object-state-channel");
     opt.tracks = eval::read_track_truths(args.get("scale-truth"), 0);
   }
   if (args.given("compare-target") && opt.target_channel.empty()) {
@@ -133,6 +136,13 @@ int run(int argc, const char* const* argv) {
                 static_cast<long long>(r.metric_without_truth), f.position_error.std(0), f.position_error.std(1),
                 f.position_error.std(2), f.orientation_error.std(0), f.orientation_error.std(1),
                 f.orientation_error.std(2));
+    std::printf("filtered object states on %s: %lld (without truth %lld); position error std %.4f / %.4f / %.4f m, "
+                "yaw/pitch/roll std %.4f / %.4f / %.4f rad, NEES position %.2f, orientation %.2f\n",
+                opt.object_state_channel.c_str(), static_cast<long long>(f.filtered_poses.size()),
+                static_cast<long long>(r.object_states_without_truth), f.filtered_position_error.std(0),
+                f.filtered_position_error.std(1), f.filtered_position_error.std(2),
+                f.filtered_orientation_error.std(0), f.filtered_orientation_error.std(1),
+                f.filtered_orientation_error.std(2), f.filtered_nees_position, f.filtered_nees_orientation);
   }
 
   int status = s.count > 0 ? 0 : 2;
@@ -192,7 +202,18 @@ int run(int argc, const char* const* argv) {
                    {"object position std z [m]", f.position_error.std(2), o.position_error.std(2)},
                    {"object yaw std [rad]", f.orientation_error.std(0), o.orientation_error.std(0)},
                    {"object pitch std [rad]", f.orientation_error.std(1), o.orientation_error.std(1)},
-                   {"object roll std [rad]", f.orientation_error.std(2), o.orientation_error.std(2)}});
+                   {"object roll std [rad]", f.orientation_error.std(2), o.orientation_error.std(2)},
+                   {"filtered position std x [m]", f.filtered_position_error.std(0), o.filtered_position_error.std(0)},
+                   {"filtered position std y [m]", f.filtered_position_error.std(1), o.filtered_position_error.std(1)},
+                   {"filtered position std z [m]", f.filtered_position_error.std(2), o.filtered_position_error.std(2)},
+                   {"filtered yaw std [rad]", f.filtered_orientation_error.std(0),
+                    o.filtered_orientation_error.std(0)},
+                   {"filtered pitch std [rad]", f.filtered_orientation_error.std(1),
+                    o.filtered_orientation_error.std(1)},
+                   {"filtered roll std [rad]", f.filtered_orientation_error.std(2),
+                    o.filtered_orientation_error.std(2)},
+                   {"filtered NEES position", f.filtered_nees_position, o.filtered_nees_position},
+                   {"filtered NEES orientation", f.filtered_nees_orientation, o.filtered_nees_orientation}});
   }
   return status;
 }

@@ -103,6 +103,22 @@ void ScaleFigureBuilder::add_estimate(int64_t utime, double scale, bool accepted
   f_.accepted_scale_errors.push_back(scale / truth->s_true - 1.0);
 }
 
+void ScaleFigureBuilder::add_filtered_pose(const TargetStateEstimate& state, double scale,
+                                           const Eigen::Matrix3d& R_TtoG, const Eigen::Vector3d& p_TinG) {
+  const ObjectTruth* truth = truth_at(state.utime);
+  if (truth == nullptr) return;
+  FilteredPoseSample f;
+  const Eigen::Matrix3d R_OtoG = quat_to_rot(state.q_GtoT).transpose();
+  f.error = metric_pose_error(state.utime, scale, R_OtoG, state.p_TinG, *truth, R_TtoG, p_TinG);
+  const Eigen::Matrix3d R_OtoG_true = R_TtoG * truth->R_OtoT;
+  const ErrorSample e = compute_error(state.utime, rot_to_quat(R_OtoG_true.transpose()),
+                                      R_TtoG * truth->p_OinT + p_TinG, state.q_GtoT, state.p_TinG,
+                                      state.covariance.topLeftCorner<3, 3>(), state.covariance.block<3, 3>(3, 3));
+  f.nees_p = e.nees_p;
+  f.nees_theta = e.nees_theta;
+  f_.filtered_poses.push_back(f);
+}
+
 void ScaleFigureBuilder::add_metric_pose(int64_t utime, double scale, const Eigen::Matrix3d& R_OtoG,
                                          const Eigen::Vector3d& p_OinG, const Eigen::Matrix3d& R_TtoG,
                                          const Eigen::Vector3d& p_TinG) {
@@ -122,6 +138,21 @@ ScaleFigures ScaleFigureBuilder::figures() const {
   }
   f.position_error = mean_std3(p);
   f.orientation_error = mean_std3(o);
+  p.clear();
+  o.clear();
+  double nees_p = 0.0, nees_theta = 0.0;
+  for (const FilteredPoseSample& s : f.filtered_poses) {
+    p.push_back(s.error.err_p);
+    o.push_back(s.error.err_ypr);
+    nees_p += s.nees_p;
+    nees_theta += s.nees_theta;
+  }
+  f.filtered_position_error = mean_std3(p);
+  f.filtered_orientation_error = mean_std3(o);
+  if (!f.filtered_poses.empty()) {
+    f.filtered_nees_position = nees_p / static_cast<double>(f.filtered_poses.size());
+    f.filtered_nees_orientation = nees_theta / static_cast<double>(f.filtered_poses.size());
+  }
   return f;
 }
 
@@ -142,13 +173,27 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
   ObjectTracker tracker(options.tracker);
   ScaleFigureBuilder figures;
   auto true_target = [&sim](int64_t utime) { return sim.target_state(sim.sim_time(utime)).value(); };
+  double held_scale = 0.0;  // of the metric pose the filter gets next, same frame
+  // ScaleNode calls on_pose, then runs the object filter (update, outputs,
+  // prediction), then on_object_state: the time between the two is the filter's.
+  std::chrono::steady_clock::time_point pose_done;
+  double filter_s = 0.0;
+  int64_t filter_calls = 0;
   ScaleNode node(
       options.node, [&](const scale::ScaleResult& s) { figures.add_estimate(s.utime, s.scale, s.accepted); },
       [&](const scale::ObjectPoseInWorld& pose) {
+        held_scale = pose.scale;
         const sim::SplineState target = true_target(pose.utime);
         figures.add_metric_pose(pose.utime, pose.scale, pose.R_OtoG, pose.p_OinG, target.R_BtoG, target.p_BinG);
+        pose_done = std::chrono::steady_clock::now();
       },
-      {});
+      {},
+      [&](const TargetStateEstimate& state, const TargetPosePrediction&) {
+        filter_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - pose_done).count();
+        ++filter_calls;
+        const sim::SplineState target = true_target(state.utime);
+        figures.add_filtered_pose(state, held_scale, target.R_BtoG, target.p_BinG);
+      });
 
   TrajectoryErrors vio_errors;
   GroundTruth truth;
@@ -190,6 +235,7 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
   r.vio = vio_errors.summary();
   r.figures = figures.figures();
   r.tracker_ms_mean = r.frames > 0 ? 1e3 * tracker_s / static_cast<double>(r.frames) : 0.0;
+  r.filter_us_mean = filter_calls > 0 ? 1e6 * filter_s / static_cast<double>(filter_calls) : 0.0;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return r;
 }
@@ -208,9 +254,17 @@ void write_scale_run_json(JsonWriter& j, const ScaleRunResult& r) {
   write_vec(j, "position_error_std_m", f.position_error.std);
   write_vec(j, "ypr_error_mean_rad", f.orientation_error.mean);
   write_vec(j, "ypr_error_std_rad", f.orientation_error.std);
+  j.field("filtered_poses", static_cast<int64_t>(f.filtered_poses.size()));
+  write_vec(j, "filtered_position_error_mean_m", f.filtered_position_error.mean);
+  write_vec(j, "filtered_position_error_std_m", f.filtered_position_error.std);
+  write_vec(j, "filtered_ypr_error_mean_rad", f.filtered_orientation_error.mean);
+  write_vec(j, "filtered_ypr_error_std_rad", f.filtered_orientation_error.std);
+  j.field("filtered_nees_position", f.filtered_nees_position);
+  j.field("filtered_nees_orientation", f.filtered_nees_orientation);
   j.key("vio");
   write_summary_json(j, r.vio);
-  j.field("tracker_ms_mean", r.tracker_ms_mean).field("vio_diverged", r.vio_diverged).field("wall_s", r.wall_s);
+  j.field("tracker_ms_mean", r.tracker_ms_mean).field("filter_us_mean", r.filter_us_mean);
+  j.field("vio_diverged", r.vio_diverged).field("wall_s", r.wall_s);
   j.key("tracks").begin_array();
   for (const TrackTruth& t : r.tracks) {
     j.begin_object();
@@ -263,6 +317,12 @@ ScaleFigures read_scale_figures(const std::string& summary_json, std::size_t run
     f.position_error.std = read_vec(r.at("position_error_std_m"));
     f.orientation_error.mean = read_vec(r.at("ypr_error_mean_rad"));
     f.orientation_error.std = read_vec(r.at("ypr_error_std_rad"));
+    f.filtered_position_error.mean = read_vec(r.at("filtered_position_error_mean_m"));
+    f.filtered_position_error.std = read_vec(r.at("filtered_position_error_std_m"));
+    f.filtered_orientation_error.mean = read_vec(r.at("filtered_ypr_error_mean_rad"));
+    f.filtered_orientation_error.std = read_vec(r.at("filtered_ypr_error_std_rad"));
+    f.filtered_nees_position = r.at("filtered_nees_position").number();
+    f.filtered_nees_orientation = r.at("filtered_nees_orientation").number();
     return f;
   } catch (const std::exception& e) {
     throw std::runtime_error("'" + summary_json + "': " + e.what());

@@ -13,7 +13,10 @@
 //  * object in world (each published metric pose, Eq. 21): error p̂_OinG −
 //    p_OinG per axis of G, mean and standard deviation (m); orientation
 //    error R̂_OtoG R_OtoGᵀ as yaw (about z of G), pitch, roll (ZYX), mean and
-//    standard deviation (rad).
+//    standard deviation (rad);
+//  * the object motion filter's states (OBJECT_STATE, docs/object_motion_filter.md)
+//    the same way, plus their NEES: position (3 dof, δp in G) and
+//    orientation (3 dof, δθ in O, R_GtoO = Exp(−δθ) R̂_GtoO), each averaged.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -26,6 +29,7 @@
 #include "common/eval/json.h"
 #include "common/eval/metrics.h"
 #include "common/sim/sim_config.h"
+#include "common/types/target_state.h"
 #include "procs/eval/object_truth.h"
 #include "procs/object_tracker/object_tracker.h"
 #include "procs/scale_estimator/scale_node.h"
@@ -54,6 +58,14 @@ MetricPoseSample metric_pose_error(int64_t utime, double scale, const Eigen::Mat
                                    const Eigen::Vector3d& p_OinG, const ObjectTruth& truth,
                                    const Eigen::Matrix3d& R_TtoG, const Eigen::Vector3d& p_TinG);
 
+/// One filtered object state (T = O) against the truth: the pose error as
+/// metric_pose_error's (scale: the held scale of the same frame) and its NEES.
+struct FilteredPoseSample {
+  MetricPoseSample error;
+  double nees_p{0.0};      // 3 dof
+  double nees_theta{0.0};  // 3 dof
+};
+
 struct MeanStd3 {
   Eigen::Vector3d mean{Eigen::Vector3d::Zero()};
   Eigen::Vector3d std{Eigen::Vector3d::Zero()};  // sample standard deviation (n − 1)
@@ -69,6 +81,12 @@ struct ScaleFigures {
   std::vector<MetricPoseSample> metric_poses;
   MeanStd3 position_error;     // m, over metric_poses
   MeanStd3 orientation_error;  // rad, yaw / pitch / roll
+  // The object motion filter's states (OBJECT_STATE).
+  std::vector<FilteredPoseSample> filtered_poses;
+  MeanStd3 filtered_position_error;     // m
+  MeanStd3 filtered_orientation_error;  // rad, yaw / pitch / roll
+  double filtered_nees_position{0.0};     // mean over filtered_poses (0 if none)
+  double filtered_nees_orientation{0.0};
 };
 
 /// Accumulates estimates and metric poses into ScaleFigures; the truth of
@@ -80,6 +98,10 @@ class ScaleFigureBuilder {
   void add_estimate(int64_t utime, double scale, bool accepted);
   void add_metric_pose(int64_t utime, double scale, const Eigen::Matrix3d& R_OtoG, const Eigen::Vector3d& p_OinG,
                        const Eigen::Matrix3d& R_TtoG, const Eigen::Vector3d& p_TinG);
+  /// A filtered object state (global representation, T = O) with the scale
+  /// held for its frame.
+  void add_filtered_pose(const TargetStateEstimate& state, double scale, const Eigen::Matrix3d& R_TtoG,
+                         const Eigen::Vector3d& p_TinG);
   ScaleFigures figures() const;
 
  private:
@@ -105,6 +127,7 @@ struct ScaleRunResult {
   ScaleFigures figures;
   ErrorSummary vio;            // camera-rate VIO accuracy (as vimot-vio-eval)
   double tracker_ms_mean{0.0};
+  double filter_us_mean{0.0};  // µs, object motion filter per accepted metric pose (update, outputs, prediction)
   bool vio_diverged{false};
   std::string divergence_reason;
   double wall_s{0.0};

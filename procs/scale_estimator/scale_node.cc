@@ -1,10 +1,13 @@
 #include "procs/scale_estimator/scale_node.h"
 
 #include <algorithm>
+#include <cmath>
+#include <set>
 #include <stdexcept>
 
 #include "common/config/config.h"
 #include "common/math/quat.h"
+#include "common/target/target_output.h"
 
 namespace vimot {
 
@@ -23,6 +26,43 @@ void ScaleNodeOptions::validate() const {
   if (!(estimate_period_s >= 0.0)) {
     throw std::invalid_argument("estimate_period_s must be >= 0, got " + std::to_string(estimate_period_s));
   }
+  validate_object_filter();
+}
+
+void ScaleNodeOptions::validate_object_filter() const {
+  filter.validate();
+  if (!(prediction_horizon_s >= 0.0) || !std::isfinite(prediction_horizon_s)) {
+    throw std::invalid_argument("prediction_horizon_s must be finite and >= 0");
+  }
+}
+
+void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* options) {
+  if (!cfg.has("object_filter")) return;
+  static const std::set<std::string> kKeys = {
+      "sigma_v",      "sigma_w",      "k_lateral",       "k_depth",
+      "sigma_theta",  "init_sigma_v", "init_sigma_w",    "chi2_multiplier",
+      "max_consecutive_rejections",   "max_gap_s",       "prediction_horizon_s"};
+  const Config sec = cfg.sub("object_filter");
+  for (const std::string& k : sec.keys()) {
+    if (!kKeys.count(k)) sec.fail(k, "is not an object_filter option");
+  }
+  target::ObjectPoseFilterOptions& f = options->filter;
+  if (sec.has("sigma_v")) f.noise.sigma_v = Eigen::Vector3d::Constant(sec.get<double>("sigma_v"));
+  if (sec.has("sigma_w")) f.noise.sigma_w = Eigen::Vector3d::Constant(sec.get<double>("sigma_w"));
+  f.k_lateral = sec.get_or<double>("k_lateral", f.k_lateral);
+  f.k_depth = sec.get_or<double>("k_depth", f.k_depth);
+  if (sec.has("sigma_theta")) f.sigma_theta_C = sec.get_vec<3>("sigma_theta");
+  f.init_sigma_v = sec.get_or<double>("init_sigma_v", f.init_sigma_v);
+  f.init_sigma_w = sec.get_or<double>("init_sigma_w", f.init_sigma_w);
+  f.chi2_multiplier = sec.get_or<double>("chi2_multiplier", f.chi2_multiplier);
+  f.max_consecutive_rejections = sec.get_or<int>("max_consecutive_rejections", f.max_consecutive_rejections);
+  f.max_gap_s = sec.get_or<double>("max_gap_s", f.max_gap_s);
+  options->prediction_horizon_s = sec.get_or<double>("prediction_horizon_s", options->prediction_horizon_s);
+  try {
+    options->validate_object_filter();
+  } catch (const std::invalid_argument& e) {
+    cfg.fail("object_filter", e.what());
+  }
 }
 
 ScaleNodeOptions scale_node_options_from_config(const Config& cfg) {
@@ -32,6 +72,7 @@ ScaleNodeOptions scale_node_options_from_config(const Config& cfg) {
   o.camera = camera_from_config(calib.sub("cameras.cam0"));
   o.max_pending = cfg.get_or<int>("node.max_pending", o.max_pending);
   o.estimate_period_s = cfg.get_or<double>("node.estimate_period_s", o.estimate_period_s);
+  object_filter_options_from_config(cfg, &o);
   try {
     o.validate();
   } catch (const std::invalid_argument& e) {
@@ -41,12 +82,14 @@ ScaleNodeOptions scale_node_options_from_config(const Config& cfg) {
 }
 
 ScaleNode::ScaleNode(const ScaleNodeOptions& options, ScaleCallback on_scale, PoseCallback on_pose,
-                     EventCallback on_event)
+                     EventCallback on_event, ObjectStateCallback on_object_state)
     : options_((options.validate(), options)),
       estimator_(options.estimator),
       on_scale_(std::move(on_scale)),
       on_pose_(std::move(on_pose)),
-      on_event_(std::move(on_event)) {}
+      on_event_(std::move(on_event)),
+      on_object_state_(std::move(on_object_state)),
+      filter_(options.filter) {}
 
 void ScaleNode::say(VinsEvent::Kind kind, const std::string& message) {
   if (on_event_) on_event_(VinsEvent{kind, message});
@@ -113,8 +156,9 @@ void ScaleNode::on_object_pose(const ObjectPoseEstimate& pose) {
   if (track_id_ && *track_id_ != pose.track_id) {
     ++stats_.new_tracks;
     say(VinsEvent::Kind::kInfo, "new object track " + std::to_string(pose.track_id) + " at utime " +
-                                    std::to_string(pose.utime) + ": scale estimator reset");
+                                    std::to_string(pose.utime) + ": scale estimator and object filter reset");
     estimator_.reset();
+    filter_.reset();
     last_estimate_utime_.reset();
   }
   track_id_ = pose.track_id;
@@ -168,7 +212,34 @@ void ScaleNode::process_pair(const NavState& state, const ObjectPoseEstimate& po
   if (const auto metric = estimator_.latest_object_pose()) {
     ++stats_.metric_poses;
     if (on_pose_) on_pose_(*metric);
+    filter_pose(state, camera, *metric);
   }
+}
+
+void ScaleNode::filter_pose(const NavState& state, const CameraPoseInWorld& camera,
+                            const scale::ObjectPoseInWorld& metric) {
+  target::ObjectPoseMeasurement z;
+  z.utime = metric.utime;
+  z.q_GtoO = metric.q_GtoO;
+  z.p_OinG = metric.p_OinG;
+  z.p_OinC = metric.p_OinC;
+  z.R_CtoG = camera.R_CtoG;
+  const target::ObjectFilterStatus status = filter_.add(z);
+  if (!target::is_accepted(status)) {
+    say(VinsEvent::Kind::kDropped, "object filter at utime " + std::to_string(z.utime) + ": " +
+                                       target::to_string(status));
+    return;
+  }
+  if (status == target::ObjectFilterStatus::kReinitialized) {
+    say(VinsEvent::Kind::kInfo, "object filter re-initialised at utime " + std::to_string(z.utime));
+  }
+  ++stats_.object_states;
+  if (!on_object_state_) return;
+  const target::PoseValue imu{state.q_GtoI, state.p_IinG};
+  on_object_state_(target::target_state_estimate(filter_.utime(), target::TargetRepresentation::kGlobal,
+                                                 filter_.value(), filter_.covariance(), imu, 0),
+                   target::target_pose_prediction(filter_.utime(), options_.prediction_horizon_s,
+                                                  filter_.predict(options_.prediction_horizon_s), imu));
 }
 
 }  // namespace vimot

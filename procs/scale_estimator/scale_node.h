@@ -18,6 +18,14 @@
 // track_id means a re-initialised tracker whose length unit (the initial
 // depth, scale paper Fig. 5) differs: window and held scale are reset.
 // Within a track the last accepted scale is held until a new one is accepted.
+//
+// Object motion filter (common/target/object_pose_filter.h,
+// docs/object_motion_filter.md): every metric pose is fed to a world-frame
+// EKF whose accepted states (and a prediction prediction_horizon_s ahead)
+// go to on_object_state. A new track_id resets it with the estimator: O and
+// the length unit change. Tracking loss does not: the held scale and O
+// stay valid, and a gap longer than the filter's max_gap_s re-initialises
+// it from the next pose anyway (the filter's own, time-based rule).
 
 #include <cstdint>
 #include <deque>
@@ -28,8 +36,10 @@
 #include <Eigen/Core>
 
 #include "common/camera/camera_model.h"
+#include "common/target/object_pose_filter.h"
 #include "common/types/nav_state.h"
 #include "common/types/object_pose.h"
+#include "common/types/target_state.h"
 #include "procs/scale_estimator/scale_estimator.h"
 #include "procs/vins/vins_node.h"
 
@@ -55,16 +65,29 @@ struct ScaleNodeOptions {
   /// Estimate (and publish SCALE_ESTIMATE) at most every this many seconds
   /// of message time; 0 = for every pair.
   double estimate_period_s{0.0};
+  /// The object motion filter and how far ahead its prediction looks.
+  target::ObjectPoseFilterOptions filter;
+  double prediction_horizon_s{0.5};  // s, as the target filter's TARGET_PREDICTION
 
   /// Throws std::invalid_argument naming the bad option.
   void validate() const;
+  /// The part of validate() for filter and prediction_horizon_s.
+  void validate_object_filter() const;
 };
 
 /// From a config/scale_estimator.yaml: `scale_estimator:` (the core's
-/// options), `node:` (max_pending, estimate_period_s) and cam0 of
+/// options), `node:` (max_pending, estimate_period_s), `object_filter:`
+/// (object_filter_options_from_config) and cam0 of
 /// `calibration_file` (ASL layout, relative to the config's directory).
 /// Throws ConfigError naming the file and key.
 ScaleNodeOptions scale_node_options_from_config(const Config& cfg);
+
+/// The optional `object_filter:` section into *options: sigma_v, sigma_w
+/// (isotropic densities), k_lateral, k_depth, sigma_theta (3, per camera
+/// axis), init_sigma_v, init_sigma_w, chi2_multiplier,
+/// max_consecutive_rejections, max_gap_s, prediction_horizon_s. An unknown
+/// key is a ConfigError.
+void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* options);
 
 struct ScaleNodeStats {
   int64_t states_in{0};            // updated VINS states received
@@ -78,18 +101,22 @@ struct ScaleNodeStats {
   int64_t rejected_observations{0};  // pairs the core refused (non-finite, bad quaternion, time order)
   int64_t estimates{0};            // SCALE_ESTIMATE published
   int64_t metric_poses{0};         // OBJECT_POSE_METRIC published
+  int64_t object_states{0};        // OBJECT_STATE (and OBJECT_PREDICTION) published
 };
 
 class ScaleNode {
  public:
   using ScaleCallback = std::function<void(const scale::ScaleResult&)>;
   using PoseCallback = std::function<void(const scale::ObjectPoseInWorld&)>;
+  /// The filtered object (global representation, T = O; q_ItoT, p_TinI from
+  /// the paired VINS pose) and its prediction, per accepted metric pose.
+  using ObjectStateCallback = std::function<void(const TargetStateEstimate&, const TargetPosePrediction&)>;
   /// The event kinds of the estimator processes (info, dropped, error).
   using EventCallback = std::function<void(const VinsEvent&)>;
 
   /// Throws std::invalid_argument on invalid options.
   ScaleNode(const ScaleNodeOptions& options, ScaleCallback on_scale, PoseCallback on_pose,
-            EventCallback on_event);
+            EventCallback on_event, ObjectStateCallback on_object_state = {});
 
   /// Only camera-rate states (updated = true) are used; IMU-rate ones are ignored.
   void on_nav_state(const NavState& state);
@@ -97,6 +124,7 @@ class ScaleNode {
 
   const ScaleNodeStats& stats() const { return stats_; }
   const scale::ScaleEstimator& estimator() const { return estimator_; }
+  const target::ObjectPoseFilter& filter() const { return filter_; }
   std::size_t pending_states() const { return states_.size(); }
   std::size_t pending_object_poses() const { return object_poses_.size(); }
 
@@ -107,6 +135,7 @@ class ScaleNode {
   template <typename T>
   void drop_older(std::deque<T>* queue, int64_t utime, int64_t* counter, const char* what);
   void process_pair(const NavState& state, const ObjectPoseEstimate& pose);
+  void filter_pose(const NavState& state, const CameraPoseInWorld& camera, const scale::ObjectPoseInWorld& metric);
   void say(VinsEvent::Kind kind, const std::string& message);
 
   ScaleNodeOptions options_;
@@ -114,6 +143,8 @@ class ScaleNode {
   ScaleCallback on_scale_;
   PoseCallback on_pose_;
   EventCallback on_event_;
+  ObjectStateCallback on_object_state_;
+  target::ObjectPoseFilter filter_;
   std::deque<NavState> states_;
   std::deque<ObjectPoseEstimate> object_poses_;
   std::optional<int64_t> last_state_utime_;

@@ -7,8 +7,8 @@
 #include "common/eval/initial_estimate.h"
 #include "common/eval/nav_state_of.h"
 #include "common/eval/vins_config.h"
-#include "common/target/target_conversion.h"
 #include "common/target/target_model.h"
+#include "common/target/target_output.h"
 
 namespace vimot {
 
@@ -68,29 +68,9 @@ TargetFilterNodeOptions node_options_from_config(const Config& cfg) {
 }
 
 TargetStateEstimate target_state_of(const estimator::VioEstimator& estimator, const target::TargetFilter& filter) {
-  const target::PoseValue imu = target::imu_pose(estimator.imu_value());
-  const target::TargetValue x = filter.value();
-  TargetStateEstimate s;
-  s.utime = estimator.state_utime();
-  s.covariance = filter.covariance();
-  s.num_target_points = static_cast<int>(filter.points().size());
-  target::TargetValue local, global;
-  if (filter.options().representation == target::TargetRepresentation::kLocal) {
-    s.representation = TargetFrame::kLocal;
-    local = x;
-    global = target::local_to_global(imu, x);
-  } else {
-    s.representation = TargetFrame::kGlobal;
-    global = x;
-    local = target::global_to_local(imu, x);
-  }
-  s.q_ItoT = local.q_RtoT;
-  s.p_TinI = local.p_TinR;
-  s.q_GtoT = global.q_RtoT;
-  s.p_TinG = global.p_TinR;
-  s.v_TinT = x.v_TinT;
-  s.w_TinT = x.w_TinT;
-  return s;
+  return target::target_state_estimate(estimator.state_utime(), filter.options().representation, filter.value(),
+                                       filter.covariance(), target::imu_pose(estimator.imu_value()),
+                                       static_cast<int>(filter.points().size()));
 }
 
 TargetPosePrediction target_prediction_of(const estimator::VioEstimator& estimator,
@@ -106,16 +86,7 @@ TargetPosePrediction target_prediction_of(const estimator::VioEstimator& estimat
   } else {
     pred = target::predict_global(filter.value(), filter.covariance(), horizon_s, noise);
   }
-  TargetPosePrediction p;
-  p.utime = estimator.state_utime();
-  p.prediction_utime = p.utime + static_cast<int64_t>(std::llround(horizon_s * 1e6));
-  p.q_GtoT = pred.x.q_RtoT;
-  p.p_TinG = pred.x.p_TinR;
-  const target::TargetValue rel = target::global_to_local(imu, pred.x);
-  p.q_ItoT = rel.q_RtoT;
-  p.p_TinI = rel.p_TinR;
-  p.covariance = pred.P.topLeftCorner<6, 6>();
-  return p;
+  return target::target_pose_prediction(estimator.state_utime(), horizon_s, pred, imu);
 }
 
 namespace {

@@ -277,10 +277,23 @@ TEST_CASE("Log evaluation of the scale pipeline: estimates and metric poses agai
     w.write("OBJECT_POSE_METRIC", metric_at(300, Eigen::Vector3d(0.03, 0, 0), 0.03), 300);
     w.write("OBJECT_POSE_METRIC", metric_at(350, Eigen::Vector3d::Zero(), 0.0), 350);  // no truth at 350
     w.raw("OBJECT_POSE_METRIC", {1, 2, 3}, 360);                                       // corrupt
+    // Filtered states: at 200 2 cm off in y (σ 1 cm: NEES 4), at 300 exact; at 250 no metric pose.
+    for (const auto& [t, dy] : {std::pair<int64_t, double>{200, 0.02}, {250, 0.0}, {300, 0.0}}) {
+      const GroundTruth gt = truth_with_target(t);
+      const Eigen::Matrix3d R_TtoG = quat_to_rot(gt.q_GtoT).transpose();
+      TargetStateEstimate s;
+      s.utime = t;
+      s.representation = TargetFrame::kGlobal;
+      s.q_GtoT = gt.q_GtoT;
+      s.p_TinG = R_TtoG * track.truth.p_OinT + gt.p_TinG + Eigen::Vector3d(0, dy, 0);
+      s.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
+      w.write("OBJECT_STATE", to_lcm(s), t);
+    }
   }
   LogEvalOptions o;
   o.scale_channel = "SCALE_ESTIMATE";
   o.metric_channel = "OBJECT_POSE_METRIC";
+  o.object_state_channel = "OBJECT_STATE";
   o.tracks = {track};
   const LogEvalResult r = evaluate_log(path, o);
   CHECK(r.malformed_scale == 1);
@@ -293,6 +306,12 @@ TEST_CASE("Log evaluation of the scale pipeline: estimates and metric poses agai
   CHECK_THAT(r.scale.position_error.std(0), WithinAbs(std::sqrt(2.0) * 0.01, 1e-12));
   CHECK_THAT(r.scale.orientation_error.mean(0), WithinAbs(0.02, 1e-12));
   CHECK_THAT(r.scale.orientation_error.std(0), WithinAbs(std::sqrt(2.0) * 0.01, 1e-12));
+  CHECK(r.object_states_without_truth == 1);
+  REQUIRE(r.scale.filtered_poses.size() == 2);
+  CHECK(r.scale.filtered_poses[0].error.scale == 2.1);
+  CHECK_THAT(r.scale.filtered_position_error.mean(1), WithinAbs(0.01, 1e-12));
+  CHECK_THAT(r.scale.filtered_nees_position, WithinAbs(2.0, 1e-6));
+  CHECK_THAT(r.scale.filtered_nees_orientation, WithinAbs(0.0, 1e-9));
   std::remove(path.c_str());
 }
 

@@ -83,6 +83,33 @@ TEST_CASE("scale figures: per-track truth, mean / std per axis, |error| statisti
   CHECK(std::isnan(ScaleFigureBuilder().figures().final_scale_error));
 }
 
+TEST_CASE("filtered object states: pose error as the metric poses', NEES of position and orientation",
+          "[eval][scale]") {
+  const ObjectTruth t = truth_a();
+  const Eigen::Matrix3d R_TtoG = exp_so3(Eigen::Vector3d(0.0, 0.0, 0.7));
+  const Eigen::Vector3d p_TinG(1.0, 2.0, 0.0);
+  const Eigen::Matrix3d R_OtoG_true = R_TtoG * t.R_OtoT;
+  // Estimate: 3 cm off along y of G (σ_y 1 cm: NEES 9) and R̂_GtoO = Exp(δθ) R_GtoO,true
+  // with δθ = (0, 0, 0.02) rad in O (σ 0.01 rad: NEES 4).
+  TargetStateEstimate s;
+  s.utime = 2000;
+  s.representation = TargetFrame::kGlobal;
+  s.q_GtoT = rot_to_quat(exp_so3(Eigen::Vector3d(0, 0, 0.02)) * R_OtoG_true.transpose());
+  s.p_TinG = R_TtoG * t.p_OinT + p_TinG + Eigen::Vector3d(0, 0.03, 0);
+  s.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
+  ScaleFigureBuilder b;
+  b.add_filtered_pose(s, 2.0, R_TtoG, p_TinG);  // before the track: ignored
+  b.start_track(1000, t);
+  b.add_filtered_pose(s, 2.0, R_TtoG, p_TinG);
+  const ScaleFigures f = b.figures();
+  REQUIRE(f.filtered_poses.size() == 1);
+  CHECK((f.filtered_poses[0].error.err_p - Eigen::Vector3d(0, 0.03, 0)).norm() < 1e-12);
+  CHECK(f.filtered_poses[0].error.scale == 2.0);
+  CHECK_THAT(f.filtered_nees_position, WithinRel(9.0, 1e-9));
+  CHECK_THAT(f.filtered_nees_orientation, WithinRel(4.0, 1e-9));
+  CHECK(f.metric_poses.empty());
+}
+
 TEST_CASE("scale summary.json: the tracks' truth and the figures read back", "[eval][scale]") {
   ScaleRunResult r;
   r.sim_seed = 3;
@@ -95,6 +122,15 @@ TEST_CASE("scale summary.json: the tracks' truth and the figures read back", "[e
                     Eigen::Vector3d::Zero());
   b.add_metric_pose(2050, 2.02, truth_a().R_OtoT, truth_a().p_OinT + Eigen::Vector3d(0.03, 0, 0), R_TtoG,
                     Eigen::Vector3d::Zero());
+  TargetStateEstimate s;
+  s.utime = 2000;
+  s.q_GtoT = rot_to_quat(truth_a().R_OtoT.transpose());
+  s.p_TinG = truth_a().p_OinT + Eigen::Vector3d(0, 0.02, 0);
+  s.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;  // NEES position 4
+  b.add_filtered_pose(s, 2.02, R_TtoG, Eigen::Vector3d::Zero());
+  s.utime = 2050;
+  s.p_TinG = truth_a().p_OinT;
+  b.add_filtered_pose(s, 2.02, R_TtoG, Eigen::Vector3d::Zero());
   r.figures = b.figures();
   JsonWriter j;
   j.begin_object().key("per_run").begin_array();
@@ -114,6 +150,10 @@ TEST_CASE("scale summary.json: the tracks' truth and the figures read back", "[e
   CHECK_THAT(f.final_scale_error, WithinAbs(0.01, 1e-12));
   CHECK_THAT(f.position_error.mean(0), WithinAbs(0.02, 1e-12));
   CHECK_THAT(f.position_error.std(0), WithinAbs(std::sqrt(2.0) * 0.01, 1e-12));
+  CHECK_THAT(f.filtered_position_error.mean(1), WithinAbs(0.01, 1e-12));
+  CHECK_THAT(f.filtered_position_error.std(1), WithinAbs(std::sqrt(2.0) * 0.01, 1e-12));
+  CHECK_THAT(f.filtered_nees_position, WithinAbs(2.0, 1e-9));
+  CHECK_THAT(f.filtered_nees_orientation, WithinAbs(0.0, 1e-9));
   CHECK_THROWS_AS(read_track_truths(path, 1), std::runtime_error);
   CHECK_THROWS_AS(read_track_truths("/nonexistent.json", 0), std::runtime_error);
   std::remove(path.c_str());

@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
                   w.write("OBJECT_POSE_UPTOSCALE", t::sample_object_pose()) &&
                   w.write("SCALE_ESTIMATE", t::sample_scale_estimate()) &&
                   w.write("OBJECT_POSE_METRIC", t::sample_metric_object_pose()) &&
+                  w.write("OBJECT_STATE", t::sample_target_state()) &&
+                  w.write("OBJECT_PREDICTION", t::sample_target_prediction()) &&
                   w.write("GROUND_TRUTH", t::sample_ground_truth()) &&
                   w.write("HEARTBEAT", t::sample_heartbeat());
   if (!ok) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "common/config/config.h"
 #include "common/math/quat.h"
 #include "procs/scale_estimator/scale_node.h"
 #include "scale_scenarios.h"
@@ -235,4 +236,93 @@ TEST_CASE("scale_node: held scale for the metric pose; tracking loss resets", "[
   CHECK(!node.estimator().has_scale());
   CHECK(out.poses.size() == poses_before);
   CHECK(node.estimator().window().size() == 199);
+}
+
+TEST_CASE("scale_node: the object filter's state and prediction per metric pose, reset on a new track", "[scale]") {
+  Outputs out;
+  std::vector<TargetStateEstimate> states;
+  std::vector<TargetPosePrediction> predictions;
+  ScaleNodeOptions options;
+  options.camera = test_camera();
+  options.prediction_horizon_s = 0.25;
+  // The synthetic object shakes (up to ~14 m/s², 4 rad/s²), no ground robot: a matching random walk.
+  options.filter.noise = target::TargetNoise::isotropic(20.0, 5.0);
+  ScaleNode node(
+      options, [&out](const ScaleResult& r) { out.scales.push_back(r); },
+      [&out](const ObjectPoseInWorld& p) { out.poses.push_back(p); }, {},
+      [&](const TargetStateEstimate& s, const TargetPosePrediction& p) {
+        states.push_back(s);
+        predictions.push_back(p);
+      });
+  const CameraCalibration cam = test_camera();
+  const std::vector<ScaleObservation> normal = generate(normal_camera, normal_object, kScale, 260);
+  NavState last_state;
+  for (const ScaleObservation& o : normal) {
+    last_state = state_of(o, cam);
+    node.on_nav_state(last_state);
+    node.on_object_pose(pose_of(o));
+  }
+  REQUIRE(!out.poses.empty());
+  // Noise-free poses of a smooth motion: every one passes the gate.
+  CHECK(states.size() == out.poses.size());
+  CHECK(node.stats().object_states == static_cast<int64_t>(states.size()));
+  CHECK(node.filter().stats().initializations == 1);
+  CHECK(node.filter().stats().outliers == 0);
+
+  const TargetStateEstimate& s = states.back();
+  const ObjectPoseInWorld& metric = out.poses.back();
+  CHECK(s.utime == metric.utime);
+  CHECK(s.representation == TargetFrame::kGlobal);
+  CHECK(s.num_target_points == 0);
+  CHECK((s.p_TinG - metric.p_OinG).norm() < 0.01);  // the filter follows the (exact) poses
+  CHECK(rotation_angle_between(quat_to_rot(s.q_GtoT), metric.R_OtoG.transpose()) < 0.01);
+  // The robot-relative pose is the world pose seen from the paired VINS IMU pose.
+  const Eigen::Matrix3d R_GtoI = quat_to_rot(last_state.q_GtoI);
+  CHECK((s.p_TinI - R_GtoI * (s.p_TinG - last_state.p_IinG)).norm() < 1e-9);
+  CHECK(quat_to_rot(s.q_ItoT).isApprox(quat_to_rot(s.q_GtoT) * R_GtoI.transpose(), 1e-9));
+  CHECK(s.covariance.isApprox(node.filter().covariance()));
+  const TargetPosePrediction& p = predictions.back();
+  CHECK(p.utime == s.utime);
+  CHECK(p.prediction_utime == s.utime + 250000);
+  const target::TargetPrediction expected = node.filter().predict(0.25);
+  CHECK(p.p_TinG.isApprox(expected.x.p_TinR));
+  CHECK(p.q_GtoT.isApprox(expected.x.q_RtoT));
+  CHECK(p.covariance.trace() > s.covariance.topLeftCorner<6, 6>().trace());
+
+  // A new track: the filter is reset with the scale; nothing published until a new scale.
+  const std::size_t states_before = states.size();
+  for (const ScaleObservation& o : generate(normal_camera, normal_object, kScale, 100, 500)) {
+    node.on_nav_state(state_of(o, cam));
+    ObjectPoseEstimate pe = pose_of(o);
+    pe.track_id = 2;
+    node.on_object_pose(pe);
+  }
+  CHECK(node.stats().new_tracks == 1);
+  CHECK(!node.filter().initialized());
+  CHECK(states.size() == states_before);
+}
+
+TEST_CASE("scale_node: object_filter options from the config, unknown keys and bad values refused", "[scale]") {
+  ScaleNodeOptions o;
+  const Config cfg = Config::from_string(
+      "object_filter:\n  sigma_v: 0.2\n  sigma_w: 0.7\n  k_depth: 0.01\n  sigma_theta: [0.01, 0.02, 0.03]\n"
+      "  max_consecutive_rejections: 3\n  prediction_horizon_s: 1.5\n");
+  object_filter_options_from_config(cfg, &o);
+  CHECK(o.filter.noise.sigma_v == Eigen::Vector3d::Constant(0.2));
+  CHECK(o.filter.noise.sigma_w == Eigen::Vector3d::Constant(0.7));
+  CHECK(o.filter.k_depth == 0.01);
+  CHECK(o.filter.k_lateral == target::ObjectPoseFilterOptions().k_lateral);
+  CHECK(o.filter.sigma_theta_C == Eigen::Vector3d(0.01, 0.02, 0.03));
+  CHECK(o.filter.max_consecutive_rejections == 3);
+  CHECK(o.prediction_horizon_s == 1.5);
+  ScaleNodeOptions d;
+  object_filter_options_from_config(Config::from_string("node:\n  max_pending: 3\n"), &d);  // no section: defaults
+  CHECK(d.prediction_horizon_s == 0.5);
+  CHECK_THROWS_AS(object_filter_options_from_config(Config::from_string("object_filter:\n  sigma_x: 1\n"), &d),
+                  ConfigError);
+  CHECK_THROWS_AS(object_filter_options_from_config(Config::from_string("object_filter:\n  k_depth: -1\n"), &d),
+                  ConfigError);
+  CHECK_THROWS_AS(
+      object_filter_options_from_config(Config::from_string("object_filter:\n  prediction_horizon_s: -1\n"), &d),
+      ConfigError);
 }
