@@ -27,6 +27,12 @@ void ObjectPoseFilterOptions::validate() const {
   require(finite_positive(k_lateral), "k_lateral must be finite and > 0");
   require(finite_positive(k_depth), "k_depth must be finite and > 0");
   require(sigma_theta_C.allFinite() && (sigma_theta_C.array() > 0.0).all(), "sigma_theta_C must be finite and > 0");
+  require(std::isfinite(bias_sigma_theta) && bias_sigma_theta >= 0.0, "bias_sigma_theta must be finite and >= 0");
+  require(std::isfinite(bias_sigma_position) && bias_sigma_position >= 0.0,
+          "bias_sigma_position must be finite and >= 0");
+  require(std::isfinite(scale_sigma) && scale_sigma >= 0.0, "scale_sigma must be finite and >= 0");
+  require(std::isfinite(scale_random_walk) && scale_random_walk >= 0.0,
+          "scale_random_walk must be finite and >= 0");
   require(finite_positive(init_sigma_v), "init_sigma_v must be finite and > 0");
   require(finite_positive(init_sigma_w), "init_sigma_w must be finite and > 0");
   require(finite_positive(chi2_multiplier), "chi2_multiplier must be finite and > 0");
@@ -63,9 +69,19 @@ void ObjectPoseFilter::reset() {
   initialized_ = false;
   utime_ = 0;
   x_ = TargetValue();
+  b_.setZero();
   P_.setZero();
+  held_scale_ = 1.0;
   consecutive_rejections_ = 0;
   last_nis_ = 0.0;
+}
+
+ObjectPoseFilter::Matrix6x7d ObjectPoseFilter::bias_jacobian(const PoseValue& pose, const Eigen::Vector3d& p_CinG) {
+  Matrix6x7d H = Matrix6x7d::Zero();
+  H.topLeftCorner<3, 3>().setIdentity();
+  H.block<3, 3>(3, 3) = pose.R().transpose();  // R_OtoG
+  H.block<3, 1>(3, 6) = pose.p - p_CinG;
+  return H;
 }
 
 void ObjectPoseFilter::initialize(const ObjectPoseMeasurement& z, const Matrix6d& R) {
@@ -74,8 +90,20 @@ void ObjectPoseFilter::initialize(const ObjectPoseMeasurement& z, const Matrix6d
   x_ = TargetValue();
   x_.q_RtoT = z.q_GtoO;
   x_.p_TinR = z.p_OinG;
+  b_.setZero();
+  held_scale_ = z.scale;
+  // pose = z − H_b b − n: Cov(pose) = R + H_b P_b H_bᵀ, Cov(pose, b) = −H_b P_b.
+  Vector7d bias_var;
+  bias_var << Eigen::Vector3d::Constant(options_.bias_sigma_theta * options_.bias_sigma_theta),
+      Eigen::Vector3d::Constant(options_.bias_sigma_position * options_.bias_sigma_position),
+      options_.scale_sigma * options_.scale_sigma;
+  const Matrix6x7d H_b = bias_jacobian(PoseValue{z.q_GtoO, z.p_OinG}, z.p_OinG - z.R_CtoG * z.p_OinC);
+  const Matrix6x7d P_pose_b = -H_b * bias_var.asDiagonal();
   P_.setZero();
-  P_.topLeftCorner<6, 6>() = R;
+  P_.topLeftCorner<6, 6>() = R - P_pose_b * H_b.transpose();
+  P_.block<6, 7>(0, 12) = P_pose_b;
+  P_.block<7, 6>(12, 0) = P_pose_b.transpose();
+  P_.bottomRightCorner<7, 7>() = bias_var.asDiagonal();
   P_.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * options_.init_sigma_v * options_.init_sigma_v;
   P_.block<3, 3>(9, 9) = Eigen::Matrix3d::Identity() * options_.init_sigma_w * options_.init_sigma_w;
   consecutive_rejections_ = 0;
@@ -83,7 +111,7 @@ void ObjectPoseFilter::initialize(const ObjectPoseMeasurement& z, const Matrix6d
 
 ObjectFilterStatus ObjectPoseFilter::add(const ObjectPoseMeasurement& z_in) {
   if (!(z_in.q_GtoO.allFinite() && z_in.p_OinG.allFinite() && z_in.p_OinC.allFinite() && z_in.R_CtoG.allFinite()) ||
-      z_in.q_GtoO.norm() == 0.0 || z_in.p_OinC.norm() == 0.0) {
+      z_in.q_GtoO.norm() == 0.0 || z_in.p_OinC.norm() == 0.0 || !finite_positive(z_in.scale)) {
     ++stats_.invalid;
     return ObjectFilterStatus::kRejectedInvalid;
   }
@@ -107,16 +135,35 @@ ObjectFilterStatus ObjectPoseFilter::add(const ObjectPoseMeasurement& z_in) {
     return ObjectFilterStatus::kReinitialized;
   }
 
+  // A new held scale: ε' = ŝ_new/s − 1 = (1 + ε) ŝ_new/ŝ_old − 1, exactly.
+  const double ratio = z.scale / held_scale_;
+  if (ratio != 1.0) {
+    b_(6) = (1.0 + b_(6)) * ratio - 1.0;
+    P_.row(18) *= ratio;
+    P_.col(18) *= ratio;
+    held_scale_ = z.scale;
+  }
   Matrix12d Phi, Q;
   TargetValue x_pred;
   propagate_global(x_, dt, options_.noise, &x_pred, &Phi, &Q);
-  const Matrix12d P_pred = Phi * P_ * Phi.transpose() + Q;
+  Matrix19d Phi_full = Matrix19d::Identity(), Q_full = Matrix19d::Zero();
+  Phi_full.topLeftCorner<12, 12>() = Phi;
+  Q_full.topLeftCorner<12, 12>() = Q;
+  Q_full(18, 18) = options_.scale_random_walk * options_.scale_random_walk * dt;
+  const Matrix19d P_pred = Phi_full * P_ * Phi_full.transpose() + Q_full;
   x_ = x_pred;
   P_ = 0.5 * (P_pred + P_pred.transpose());
   utime_ = z.utime;
 
-  const Vector6d r = boxminus(PoseValue{z.q_GtoO, z.p_OinG}, x_.pose());
-  const Matrix6d S = P_.topLeftCorner<6, 6>() + R;
+  // Predicted pose: the state with the biases applied (first order in θ_b).
+  Eigen::Matrix<double, 6, 19> H = Eigen::Matrix<double, 6, 19>::Zero();
+  H.leftCols<6>().setIdentity();
+  // At the state, not at the noisy pose: a scaled copy of the object's path
+  // about the camera (ε) is as good a path, and Jacobians taken at the
+  // noisy poses would pretend otherwise (spurious information on ε).
+  H.rightCols<7>() = bias_jacobian(x_.pose(), z.p_OinG - z.R_CtoG * z.p_OinC);
+  const Vector6d r = boxminus(PoseValue{z.q_GtoO, z.p_OinG}, x_.pose()) - H.rightCols<7>() * b_;
+  const Matrix6d S = H * P_ * H.transpose() + R;
   const Eigen::LLT<Matrix6d> llt(S);
   last_nis_ = r.dot(llt.solve(r));
   if (!(last_nis_ < options_.chi2_multiplier * estimator::chi2_95(6))) {
@@ -129,19 +176,20 @@ ObjectFilterStatus ObjectPoseFilter::add(const ObjectPoseMeasurement& z_in) {
     return ObjectFilterStatus::kRejectedOutlier;
   }
   consecutive_rejections_ = 0;
-  // K = P Hᵀ S⁻¹ with H = [I₆ 0]; Joseph form keeps P symmetric positive.
-  const Matrix12x6d K = llt.solve(P_.leftCols<6>().transpose()).transpose();
-  Matrix12d IKH = Matrix12d::Identity();
-  IKH.leftCols<6>() -= K;
-  x_ = boxplus(x_, K * r);
-  const Matrix12d P_new = IKH * P_ * IKH.transpose() + K * R * K.transpose();
+  // Joseph form keeps P symmetric positive.
+  const Eigen::Matrix<double, 19, 6> K = llt.solve(H * P_).transpose();
+  const Matrix19d IKH = Matrix19d::Identity() - K * H;
+  const Eigen::Matrix<double, 19, 1> dx = K * r;
+  x_ = boxplus(x_, Vector12d(dx.head<12>()));
+  b_ += dx.tail<7>();
+  const Matrix19d P_new = IKH * P_ * IKH.transpose() + K * R * K.transpose();
   P_ = 0.5 * (P_new + P_new.transpose());
   ++stats_.updates;
   return ObjectFilterStatus::kUpdated;
 }
 
 TargetPrediction ObjectPoseFilter::predict(double horizon_s) const {
-  return predict_global(x_, P_, horizon_s, options_.noise);
+  return predict_global(x_, covariance(), horizon_s, options_.noise);
 }
 
 }  // namespace target

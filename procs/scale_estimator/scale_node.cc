@@ -40,7 +40,8 @@ void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* opti
   if (!cfg.has("object_filter")) return;
   static const std::set<std::string> kKeys = {
       "sigma_v",      "sigma_w",      "k_lateral",       "k_depth",
-      "sigma_theta",  "init_sigma_v", "init_sigma_w",    "chi2_multiplier",
+      "sigma_theta",  "bias_sigma_theta", "bias_sigma_position", "scale_sigma", "scale_random_walk",
+      "init_sigma_v", "init_sigma_w",    "chi2_multiplier",
       "max_consecutive_rejections",   "max_gap_s",       "prediction_horizon_s"};
   const Config sec = cfg.sub("object_filter");
   for (const std::string& k : sec.keys()) {
@@ -52,6 +53,10 @@ void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* opti
   f.k_lateral = sec.get_or<double>("k_lateral", f.k_lateral);
   f.k_depth = sec.get_or<double>("k_depth", f.k_depth);
   if (sec.has("sigma_theta")) f.sigma_theta_C = sec.get_vec<3>("sigma_theta");
+  f.bias_sigma_theta = sec.get_or<double>("bias_sigma_theta", f.bias_sigma_theta);
+  f.bias_sigma_position = sec.get_or<double>("bias_sigma_position", f.bias_sigma_position);
+  f.scale_sigma = sec.get_or<double>("scale_sigma", f.scale_sigma);
+  f.scale_random_walk = sec.get_or<double>("scale_random_walk", f.scale_random_walk);
   f.init_sigma_v = sec.get_or<double>("init_sigma_v", f.init_sigma_v);
   f.init_sigma_w = sec.get_or<double>("init_sigma_w", f.init_sigma_w);
   f.chi2_multiplier = sec.get_or<double>("chi2_multiplier", f.chi2_multiplier);
@@ -224,6 +229,7 @@ void ScaleNode::filter_pose(const NavState& state, const CameraPoseInWorld& came
   z.p_OinG = metric.p_OinG;
   z.p_OinC = metric.p_OinC;
   z.R_CtoG = camera.R_CtoG;
+  z.scale = metric.scale;
   const target::ObjectFilterStatus status = filter_.add(z);
   if (!target::is_accepted(status)) {
     say(VinsEvent::Kind::kDropped, "object filter at utime " + std::to_string(z.utime) + ": " +
