@@ -220,9 +220,12 @@ TEST_CASE("object_pose_filter: time going back, duplicates and non-finite input 
   z = exact_measurement(traj.utimes[2], traj.truth[2]);
   z.R_CtoG(0, 0) = std::numeric_limits<double>::infinity();
   CHECK(f.add(z) == ObjectFilterStatus::kRejectedInvalid);
+  z = exact_measurement(traj.utimes[2], traj.truth[2]);
+  z.scale = 0.0;  // the held scale's ratio would divide by it
+  CHECK(f.add(z) == ObjectFilterStatus::kRejectedInvalid);
   CHECK(f.stats().duplicates == 1);
   CHECK(f.stats().backwards == 1);
-  CHECK(f.stats().invalid == 3);
+  CHECK(f.stats().invalid == 4);
   CHECK(f.utime() == traj.utimes[1]);
   CHECK(f.value().to_vector() == before.to_vector());
   CHECK(f.covariance() == P_before);
