@@ -58,6 +58,9 @@ void TrajectoryErrors::add(const ErrorSample& s) {
   sum_sq_theta_ += s.err_theta.squaredNorm();
   sum_nees_p_ += s.nees_p;
   sum_nees_theta_ += s.nees_theta;
+  // tr P from the 3σ bounds: Σ (3σ_i / 3)².
+  sum_trace_p_ += (s.sig3_p / 3.0).squaredNorm();
+  sum_trace_theta_ += (s.sig3_theta / 3.0).squaredNorm();
   ++count_;
 }
 
@@ -70,6 +73,8 @@ ErrorSummary TrajectoryErrors::summary() const {
   r.rmse_orientation_deg = std::sqrt(sum_sq_theta_ / n) * 180.0 / M_PI;
   r.nees_position = sum_nees_p_ / n;
   r.nees_orientation = sum_nees_theta_ / n;
+  r.predicted_rmse_position_m = std::sqrt(sum_trace_p_ / n);
+  r.predicted_rmse_orientation_deg = std::sqrt(sum_trace_theta_ / n) * 180.0 / M_PI;
   return r;
 }
 
@@ -88,18 +93,22 @@ MeanStd mean_std(const std::vector<double>& v) {
 MonteCarloSummary aggregate(const std::vector<ErrorSummary>& runs) {
   MonteCarloSummary m;
   m.runs = static_cast<int>(runs.size());
-  std::vector<double> rp, rt, np, nt;
+  std::vector<double> rp, rt, np, nt, pp, pt;
   for (const ErrorSummary& r : runs) {
     rp.push_back(r.rmse_position_m);
     rt.push_back(r.rmse_orientation_deg);
     np.push_back(r.nees_position);
     nt.push_back(r.nees_orientation);
+    pp.push_back(r.predicted_rmse_position_m);
+    pt.push_back(r.predicted_rmse_orientation_deg);
     m.samples += r.count;
   }
   m.rmse_position_m = mean_std(rp);
   m.rmse_orientation_deg = mean_std(rt);
   m.nees_position = mean_std(np);
   m.nees_orientation = mean_std(nt);
+  m.predicted_rmse_position_m = mean_std(pp);
+  m.predicted_rmse_orientation_deg = mean_std(pt);
   return m;
 }
 

@@ -66,7 +66,12 @@ struct ErrorSummary {
   double rmse_orientation_deg{0.0};  // √(Σ|δθ|² / n), in degrees
   double nees_position{0.0};         // Σ NEES_p / n
   double nees_orientation{0.0};      // Σ NEES_θ / n
-  int64_t count{0};                  // n
+  // The RMSE the filter's own covariance predicts, √(Σ tr P / n): a
+  // consistent filter's RMSE is this over many runs, so it tells how far
+  // the configuration (sensors, features, window) lets the errors go down.
+  double predicted_rmse_position_m{0.0};       // √(Σ tr P_pp / n)
+  double predicted_rmse_orientation_deg{0.0};  // √(Σ tr P_θθ / n), in degrees
+  int64_t count{0};                            // n
 };
 
 /// Accumulates ErrorSamples of one run into an ErrorSummary.
@@ -82,6 +87,8 @@ class TrajectoryErrors {
   double sum_sq_theta_{0.0};
   double sum_nees_p_{0.0};
   double sum_nees_theta_{0.0};
+  double sum_trace_p_{0.0};
+  double sum_trace_theta_{0.0};
   int64_t count_{0};
 };
 
@@ -99,6 +106,8 @@ struct MonteCarloSummary {
   MeanStd rmse_orientation_deg;
   MeanStd nees_position;
   MeanStd nees_orientation;
+  MeanStd predicted_rmse_position_m;
+  MeanStd predicted_rmse_orientation_deg;
   int64_t samples{0};  // over all runs
 };
 MonteCarloSummary aggregate(const std::vector<ErrorSummary>& runs);

@@ -68,12 +68,15 @@ std::string results_table(const std::vector<SimRunResult>& runs) {
   s << row("mean", mean, a.path_length_m, a.timing, a.frames, a.msckf_used, a.slam_initialized, a.slam_updated,
            a.ate4_position_m, a.ate4_orientation_deg, a.diverged > 0 ? std::to_string(a.diverged) + " diverged" : "")
     << "\n";
+  char buf[200];
   if (runs.size() > 1) {
-    char buf[160];
     std::snprintf(buf, sizeof(buf), "%-6s %9.4f %9.4f %7.2f %7.2f", "std", a.errors.rmse_position_m.std,
                   a.errors.rmse_orientation_deg.std, a.errors.nees_position.std, a.errors.nees_orientation.std);
     s << buf << "\n";
   }
+  std::snprintf(buf, sizeof(buf), "%-6s %9.4f %9.4f   RMSE the filter's covariance predicts, sqrt(mean tr P)",
+                "pred", a.errors.predicted_rmse_position_m.mean, a.errors.predicted_rmse_orientation_deg.mean);
+  s << buf << "\n";
   return s.str();
 }
 
@@ -104,6 +107,8 @@ std::string summary_json(const std::vector<SimRunResult>& runs, const RunContext
   mean.rmse_orientation_deg = a.errors.rmse_orientation_deg.mean;
   mean.nees_position = a.errors.nees_position.mean;
   mean.nees_orientation = a.errors.nees_orientation.mean;
+  mean.predicted_rmse_position_m = a.errors.predicted_rmse_position_m.mean;
+  mean.predicted_rmse_orientation_deg = a.errors.predicted_rmse_orientation_deg.mean;
   mean.count = a.errors.samples;
   j.key("summary");
   write_summary_json(j, mean);
@@ -153,23 +158,27 @@ std::string summary_csv(const std::vector<SimRunResult>& runs) {
   std::ostringstream s;
   s << "seed,perturb_seed,rmse_position_m,rmse_orientation_deg,nees_position,nees_orientation,samples,"
        "path_length_m,frame_ms_mean,frame_ms_median,frame_ms_p95,frame_ms_max,msckf_used,slam_initialized,"
-       "slam_updated,diverged\n";
+       "slam_updated,diverged,predicted_rmse_position_m,predicted_rmse_orientation_deg\n";
   char buf[512];
   for (const SimRunResult& r : runs) {
-    std::snprintf(buf, sizeof(buf), "%llu,%llu,%.9g,%.9g,%.9g,%.9g,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d\n",
+    std::snprintf(buf, sizeof(buf),
+                  "%llu,%llu,%.9g,%.9g,%.9g,%.9g,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%.9g,%.9g\n",
                   static_cast<unsigned long long>(r.sim_seed), static_cast<unsigned long long>(r.perturb_seed),
                   r.errors.rmse_position_m, r.errors.rmse_orientation_deg, r.errors.nees_position,
                   r.errors.nees_orientation, static_cast<long long>(r.errors.count), r.path_length_m, r.timing.mean_ms,
                   r.timing.median_ms, r.timing.p95_ms, r.timing.max_ms, r.totals.msckf_used,
-                  r.totals.slam_initialized, r.totals.slam_updated, r.diverged ? 1 : 0);
+                  r.totals.slam_initialized, r.totals.slam_updated, r.diverged ? 1 : 0,
+                  r.errors.predicted_rmse_position_m, r.errors.predicted_rmse_orientation_deg);
     s << buf;
   }
   const RunAverages a = average_runs(runs);
-  std::snprintf(buf, sizeof(buf), "mean,,%.9g,%.9g,%.9g,%.9g,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n",
+  std::snprintf(buf, sizeof(buf),
+                "mean,,%.9g,%.9g,%.9g,%.9g,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%.9g,%.9g\n",
                 a.errors.rmse_position_m.mean, a.errors.rmse_orientation_deg.mean, a.errors.nees_position.mean,
                 a.errors.nees_orientation.mean, static_cast<long long>(a.errors.samples), a.path_length_m,
                 a.timing.mean_ms, a.timing.median_ms, a.timing.p95_ms, a.timing.max_ms, a.msckf_used,
-                a.slam_initialized, a.slam_updated, a.diverged);
+                a.slam_initialized, a.slam_updated, a.diverged, a.errors.predicted_rmse_position_m.mean,
+                a.errors.predicted_rmse_orientation_deg.mean);
   s << buf;
   return s.str();
 }

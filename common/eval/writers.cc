@@ -103,6 +103,8 @@ void write_summary_json(JsonWriter& json, const ErrorSummary& s) {
   json.field("rmse_orientation_deg", s.rmse_orientation_deg);
   json.field("nees_position", s.nees_position);
   json.field("nees_orientation", s.nees_orientation);
+  json.field("predicted_rmse_position_m", s.predicted_rmse_position_m);
+  json.field("predicted_rmse_orientation_deg", s.predicted_rmse_orientation_deg);
   json.field("samples", s.count);
   json.end_object();
 }
@@ -113,6 +115,8 @@ ErrorSummary summary_from_json(const JsonValue& o) {
   s.rmse_orientation_deg = o.at("rmse_orientation_deg").number();
   s.nees_position = o.at("nees_position").number();
   s.nees_orientation = o.at("nees_orientation").number();
+  s.predicted_rmse_position_m = o.at("predicted_rmse_position_m").number();
+  s.predicted_rmse_orientation_deg = o.at("predicted_rmse_orientation_deg").number();
   s.count = static_cast<int64_t>(o.at("samples").number());
   return s;
 }

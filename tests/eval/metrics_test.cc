@@ -95,6 +95,9 @@ TEST_CASE("TrajectoryErrors: RMSE and average NEES", "[eval][metrics]") {
   b.err_theta = Eigen::Vector3d(0, 0.02, 0);
   b.nees_p = 3.0;
   b.nees_theta = 6.0;
+  a.sig3_p = Eigen::Vector3d(3, 6, 0);       // tr P = 1 + 4 = 5 m²
+  b.sig3_p = Eigen::Vector3d(0, 0, 3);       // tr P = 1 m²
+  a.sig3_theta = Eigen::Vector3d(0, 0.03, 0);  // tr P = 1e-4 rad²
   t.add(a);
   t.add(b);
   const ErrorSummary s = t.summary();
@@ -104,6 +107,8 @@ TEST_CASE("TrajectoryErrors: RMSE and average NEES", "[eval][metrics]") {
   CHECK_THAT(s.rmse_orientation_deg, WithinAbs(0.9059258, 1e-6));
   CHECK_THAT(s.nees_position, WithinAbs(2.0, 1e-14));
   CHECK_THAT(s.nees_orientation, WithinAbs(4.0, 1e-14));
+  CHECK_THAT(s.predicted_rmse_position_m, WithinRel(std::sqrt(3.0), 1e-14));                  // √((5 + 1) / 2)
+  CHECK_THAT(s.predicted_rmse_orientation_deg, WithinRel(std::sqrt(0.5e-4) * kDeg, 1e-14));  // 0.4051°
 }
 
 TEST_CASE("Monte-Carlo aggregate: mean and sample std over runs", "[eval][metrics]") {
@@ -118,11 +123,15 @@ TEST_CASE("Monte-Carlo aggregate: mean and sample std over runs", "[eval][metric
   r1.rmse_orientation_deg = 1.0;
   r1.nees_position = 2.0;
   r1.nees_orientation = 3.0;
+  r1.predicted_rmse_position_m = 0.05;
+  r1.predicted_rmse_orientation_deg = 0.5;
   r1.count = 10;
   r2.rmse_position_m = 0.3;
   r2.rmse_orientation_deg = 2.0;
   r2.nees_position = 4.0;
   r2.nees_orientation = 5.0;
+  r2.predicted_rmse_position_m = 0.15;
+  r2.predicted_rmse_orientation_deg = 1.5;
   r2.count = 20;
   const MonteCarloSummary mc = aggregate(std::vector<ErrorSummary>{r1, r2});
   CHECK(mc.runs == 2);
@@ -132,6 +141,8 @@ TEST_CASE("Monte-Carlo aggregate: mean and sample std over runs", "[eval][metric
   CHECK_THAT(mc.rmse_orientation_deg.mean, WithinAbs(1.5, 1e-15));
   CHECK_THAT(mc.nees_position.mean, WithinAbs(3.0, 1e-15));
   CHECK_THAT(mc.nees_orientation.mean, WithinAbs(4.0, 1e-15));
+  CHECK_THAT(mc.predicted_rmse_position_m.mean, WithinAbs(0.1, 1e-15));
+  CHECK_THAT(mc.predicted_rmse_orientation_deg.mean, WithinAbs(1.0, 1e-15));
 }
 
 TEST_CASE("Timing statistics: mean, median, nearest-rank p95, max", "[eval][metrics]") {

@@ -123,6 +123,8 @@ TEST_CASE("JSON writer and reader", "[eval][json]") {
   s.rmse_orientation_deg = 1.25;
   s.nees_position = 2.9;
   s.nees_orientation = 3.1;
+  s.predicted_rmse_position_m = 0.2;
+  s.predicted_rmse_orientation_deg = 1.5;
   s.count = 1048;
   j.key("summary");
   write_summary_json(j, s);
@@ -147,6 +149,8 @@ TEST_CASE("JSON writer and reader", "[eval][json]") {
   CHECK(r.rmse_orientation_deg == 1.25);
   CHECK(r.nees_position == 2.9);
   CHECK(r.nees_orientation == 3.1);
+  CHECK(r.predicted_rmse_position_m == 0.2);
+  CHECK(r.predicted_rmse_orientation_deg == 1.5);
   CHECK(r.count == 1048);
   CHECK_THROWS_WITH(read_summary_json(path, "other"), Catch::Contains("other"));
   std::remove(path.c_str());
