@@ -57,5 +57,21 @@ void measurement_compress_inplace(Eigen::MatrixXd& H_x, Eigen::VectorXd& res) {
   res = qtr.head(keep);
 }
 
+void stack_and_compress(const std::vector<Eigen::MatrixXd>& Hs, const std::vector<Eigen::VectorXd>& rs, int cols,
+                        Eigen::MatrixXd* H, Eigen::VectorXd* res) {
+  Eigen::Index rows = 0;
+  for (const Eigen::VectorXd& r : rs) rows += r.size();
+  H->resize(rows, cols);
+  res->resize(rows);
+  Eigen::Index row = 0;
+  for (size_t i = 0; i < Hs.size(); ++i) {
+    const Eigen::Index n = rs[i].size();
+    H->middleRows(row, n) = Hs[i];
+    res->segment(row, n) = rs[i];
+    row += n;
+  }
+  measurement_compress_inplace(*H, *res);
+}
+
 }  // namespace estimator
 }  // namespace vimot

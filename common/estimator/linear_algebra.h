@@ -3,6 +3,7 @@
 // with isotropic noise (orthogonal row operations keep n ~ N(0, σ² I)).
 
 #include <Eigen/Core>
+#include <vector>
 
 namespace vimot {
 namespace estimator {
@@ -22,6 +23,11 @@ void nullspace_project_inplace(Eigen::MatrixXd& H_f, Eigen::MatrixXd& H_x, Eigen
 /// (H_x, res) by (R₁, Q₁ᵀ res) from H_x = Q₁ R₁ (thin QR), keeping at most
 /// rank(H_x) ≤ cols rows. The EKF update is then the same at lower cost.
 void measurement_compress_inplace(Eigen::MatrixXd& H_x, Eigen::VectorXd& res);
+
+/// Stacks the per-feature systems (Hs[i], rs[i]), all with `cols` columns,
+/// into one (H, res) and compresses it (measurement_compress_inplace).
+void stack_and_compress(const std::vector<Eigen::MatrixXd>& Hs, const std::vector<Eigen::VectorXd>& rs, int cols,
+                        Eigen::MatrixXd* H, Eigen::VectorXd* res);
 
 }  // namespace estimator
 }  // namespace vimot

@@ -243,30 +243,9 @@ bool Propagator::predict_interval(const ImuValue& x0, const ImuValue& x0_lin, in
   return true;
 }
 
-PropagationReport Propagator::propagate(State& state, int64_t utime) {
-  PropagationReport report;
-  if (utime <= state.utime()) {
-    report.message = "target time " + std::to_string(utime) + " is not after the state time " +
-                     std::to_string(state.utime());
-    return report;
-  }
-  const auto& imu = state.imu();
-  const ImuValue x0 = imu->get();
-  const ImuValue x0_lin = state.options().use_fej ? imu->get_fej() : x0;
-  ImuValue x1;
-  Matrix15d Phi, Q;
-  if (!predict_interval(x0, x0_lin, state.utime(), utime, &x1, &Phi, &Q, &report)) return report;
-  StateHelper::propagate(state, {imu}, Phi, Q);
-  const Eigen::VectorXd v = x1.to_vector();
-  imu->set_value(v);
-  imu->set_fej(v);
-  state.set_utime(utime);
-  report.ok = true;
-  return report;
-}
+PropagationReport Propagator::propagate(State& state, int64_t utime) { return propagate(state, utime, nullptr); }
 
 PropagationReport Propagator::propagate(State& state, int64_t utime, VioExtension* extension) {
-  if (extension == nullptr) return propagate(state, utime);
   PropagationReport report;
   if (utime <= state.utime()) {
     report.message = "target time " + std::to_string(utime) + " is not after the state time " +
@@ -281,8 +260,8 @@ PropagationReport Propagator::propagate(State& state, int64_t utime, VioExtensio
   if (!predict_interval(x0, x0_lin, state.utime(), utime, &x1, &Phi, &Q, &report)) return report;
   std::vector<TypePtr> order;
   Eigen::MatrixXd Phi_joint, Q_joint;
-  const bool joint = extension->propagate_jointly(state, x0, x1, Phi, Q, state.utime(), utime, &order, &Phi_joint,
-                                                  &Q_joint);
+  const bool joint = extension != nullptr && extension->propagate_jointly(state, x0, x1, Phi, Q, state.utime(), utime,
+                                                                          &order, &Phi_joint, &Q_joint);
   if (joint) {
     StateHelper::propagate(state, order, Phi_joint, Q_joint);
   } else {

@@ -123,16 +123,9 @@ void UpdaterMsckf::update(State& state, std::vector<std::shared_ptr<Feature>> fe
   }
   if (total_rows == 0) return;
   stats->msckf_rows += total_rows;
-  Eigen::MatrixXd H(total_rows, layout.total());
-  Eigen::VectorXd r(total_rows);
-  int row = 0;
-  for (size_t i = 0; i < Hs.size(); ++i) {
-    const int n = static_cast<int>(rs[i].size());
-    H.middleRows(row, n) = Hs[i];
-    r.segment(row, n) = rs[i];
-    row += n;
-  }
-  measurement_compress_inplace(H, r);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd r;
+  stack_and_compress(Hs, rs, layout.total(), &H, &r);
   StateHelper::ekf_update(state, layout.order(), H, r, Eigen::MatrixXd::Identity(r.size(), r.size()));
 }
 

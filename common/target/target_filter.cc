@@ -605,16 +605,9 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
   }
   if (total_rows == 0) return;
   stats_.rows += total_rows;
-  Eigen::MatrixXd H(total_rows, layout.total());
-  Eigen::VectorXd r(total_rows);
-  int row = 0;
-  for (size_t i = 0; i < Hs.size(); ++i) {
-    const int n = static_cast<int>(rs[i].size());
-    H.middleRows(row, n) = Hs[i];
-    r.segment(row, n) = rs[i];
-    row += n;
-  }
-  estimator::measurement_compress_inplace(H, r);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd r;
+  estimator::stack_and_compress(Hs, rs, layout.total(), &H, &r);
   const bool applied = apply_update(state, layout.order(), H, r);
   if (applied) ++stats_.updates;
 }

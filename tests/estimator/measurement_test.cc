@@ -338,6 +338,16 @@ TEST_CASE("Measurement compression keeps the information", "[measurement]") {
   CHECK(Hc.rows() == n);
   CHECK((Hc.transpose() * Hc - H.transpose() * H).cwiseAbs().maxCoeff() < 1e-10);
   CHECK((Hc.transpose() * rc - H.transpose() * r).cwiseAbs().maxCoeff() < 1e-10);
+
+  // Stacked in pieces of 7, 3 and 30 rows: the same information.
+  const std::vector<Eigen::MatrixXd> Hs = {H.topRows(7), H.middleRows(7, 3), H.bottomRows(30)};
+  const std::vector<Eigen::VectorXd> rs = {r.head(7), r.segment(7, 3), r.tail(30)};
+  Eigen::MatrixXd Hs_c;
+  Eigen::VectorXd rs_c;
+  stack_and_compress(Hs, rs, n, &Hs_c, &rs_c);
+  CHECK(Hs_c.rows() == n);
+  CHECK((Hs_c.transpose() * Hs_c - H.transpose() * H).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((Hs_c.transpose() * rs_c - H.transpose() * r).cwiseAbs().maxCoeff() < 1e-10);
 }
 
 TEST_CASE("Triangulation recovers a point from stereo tracks", "[triangulation]") {
