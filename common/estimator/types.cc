@@ -129,6 +129,26 @@ ImuValue ImuValue::from_vector(const Eigen::Matrix<double, 16, 1>& x) {
   return v;
 }
 
+ImuValue boxplus(const ImuValue& x, const Eigen::Matrix<double, 15, 1>& dx) {
+  ImuValue y = x;
+  y.q_GtoI = quat_boxplus(x.q_GtoI, dx.segment<3>(0));
+  y.p_IinG += dx.segment<3>(3);
+  y.v_IinG += dx.segment<3>(6);
+  y.bg += dx.segment<3>(9);
+  y.ba += dx.segment<3>(12);
+  return y;
+}
+
+Eigen::Matrix<double, 15, 1> boxminus(const ImuValue& y, const ImuValue& x) {
+  Eigen::Matrix<double, 15, 1> d;
+  d.segment<3>(0) = -log_so3(quat_to_rot(y.q_GtoI) * quat_to_rot(x.q_GtoI).transpose());
+  d.segment<3>(3) = y.p_IinG - x.p_IinG;
+  d.segment<3>(6) = y.v_IinG - x.v_IinG;
+  d.segment<3>(9) = y.bg - x.bg;
+  d.segment<3>(12) = y.ba - x.ba;
+  return d;
+}
+
 // ---------------------------------------------------------------- ImuState
 ImuState::ImuState()
     : Type(15),

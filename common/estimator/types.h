@@ -121,6 +121,12 @@ struct ImuValue {
   static ImuValue from_vector(const Eigen::Matrix<double, 16, 1>& x);
 };
 
+/// x ⊞ δ with the error state [δθ; δp; δv; δbg; δba] of ImuState::update:
+/// q ← quat_boxplus(q, δθ) (R = Exp(−δθ) R̂), the rest additive.
+ImuValue boxplus(const ImuValue& x, const Eigen::Matrix<double, 15, 1>& dx);
+/// y ⊟ x: the δ with y = x ⊞ δ.
+Eigen::Matrix<double, 15, 1> boxminus(const ImuValue& y, const ImuValue& x);
+
 /// IMU state: value 16 [q_GtoI; p_IinG; v_IinG; bg; ba], error 15
 /// [δθ; δp; δv; δbg; δba]. pose() (error rows 0..5), v(), bg(), ba() are
 /// addressable parts for measurement Jacobians.

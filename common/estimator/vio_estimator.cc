@@ -207,19 +207,22 @@ ImuFeedStatus VioEstimator::feed_imu(const ImuData& imu) {
   return status;
 }
 
-void VioEstimator::initialize(const ImuValue& value, int64_t utime) {
-  const InitSigmas& s = options_.init_sigmas;
+Matrix15d initial_covariance(const Eigen::Vector4d& q_GtoI, const InitSigmas& s) {
   Matrix15d P = Matrix15d::Zero();
   // Roll/pitch vs yaw: the orientation error is in the IMU frame; rotate the
   // G-frame diag(rp, rp, yaw) into it: P_θ = R_GtoI diag R_GtoIᵀ.
-  const Eigen::Matrix3d R = quat_to_rot(quat_normalize(value.q_GtoI));
+  const Eigen::Matrix3d R = quat_to_rot(quat_normalize(q_GtoI));
   const Eigen::Vector3d dg(s.theta_rp * s.theta_rp, s.theta_rp * s.theta_rp, s.theta_yaw * s.theta_yaw);
   P.block<3, 3>(0, 0) = R * dg.asDiagonal() * R.transpose();
   P.block<3, 3>(3, 3) = s.p * s.p * Eigen::Matrix3d::Identity();
   P.block<3, 3>(6, 6) = s.v * s.v * Eigen::Matrix3d::Identity();
   P.block<3, 3>(9, 9) = s.bg * s.bg * Eigen::Matrix3d::Identity();
   P.block<3, 3>(12, 12) = s.ba * s.ba * Eigen::Matrix3d::Identity();
-  initialize(value, utime, P);
+  return P;
+}
+
+void VioEstimator::initialize(const ImuValue& value, int64_t utime) {
+  initialize(value, utime, initial_covariance(value.q_GtoI, options_.init_sigmas));
 }
 
 void VioEstimator::initialize(const ImuValue& value, int64_t utime, const Matrix15d& P_imu) {

@@ -53,6 +53,11 @@ struct InitSigmas {
   double ba{0.05};        // m/s²
 };
 
+/// P0 of VioEstimator::initialize(value, utime) for an IMU orientation
+/// q_GtoI: roll/pitch and yaw σ are about G's axes, rotated into the
+/// IMU-frame orientation error; position, velocity, biases isotropic.
+Matrix15d initial_covariance(const Eigen::Vector4d& q_GtoI, const InitSigmas& sigmas);
+
 struct DivergenceOptions {
   double max_position_correction_m{2.0};  // |Δp| of one frame's updates
   double max_velocity_mps{100.0};

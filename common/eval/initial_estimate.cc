@@ -9,18 +9,6 @@
 namespace vimot {
 namespace eval {
 
-estimator::Matrix15d initial_covariance(const Eigen::Vector4d& q_GtoI, const estimator::InitSigmas& s) {
-  estimator::Matrix15d P = estimator::Matrix15d::Zero();
-  const Eigen::Matrix3d R = quat_to_rot(quat_normalize(q_GtoI));
-  const Eigen::Vector3d dg(s.theta_rp * s.theta_rp, s.theta_rp * s.theta_rp, s.theta_yaw * s.theta_yaw);
-  P.block<3, 3>(0, 0) = R * dg.asDiagonal() * R.transpose();
-  P.block<3, 3>(3, 3) = s.p * s.p * Eigen::Matrix3d::Identity();
-  P.block<3, 3>(6, 6) = s.v * s.v * Eigen::Matrix3d::Identity();
-  P.block<3, 3>(9, 9) = s.bg * s.bg * Eigen::Matrix3d::Identity();
-  P.block<3, 3>(12, 12) = s.ba * s.ba * Eigen::Matrix3d::Identity();
-  return P;
-}
-
 InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioOptions& options,
                                  uint64_t perturb_seed) {
   InitialEstimate init;
@@ -29,7 +17,7 @@ InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioO
   init.value.v_IinG = truth.v_IinG;
   init.value.bg = truth.bias_gyro;
   init.value.ba = truth.bias_accel;
-  init.P0 = initial_covariance(init.value.q_GtoI, options.init_sigmas);
+  init.P0 = estimator::initial_covariance(init.value.q_GtoI, options.init_sigmas);
   if (perturb_seed == 0) return init;
 
   const Eigen::LLT<estimator::Matrix15d> llt(init.P0);
@@ -41,11 +29,7 @@ InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioO
   Eigen::Matrix<double, 15, 1> n;
   for (int i = 0; i < 15; ++i) n(i) = n01(rng);
   const Eigen::Matrix<double, 15, 1> d = llt.matrixL() * n;
-  init.value.q_GtoI = quat_boxplus(init.value.q_GtoI, d.segment<3>(0));
-  init.value.p_IinG += d.segment<3>(3);
-  init.value.v_IinG += d.segment<3>(6);
-  init.value.bg += d.segment<3>(9);
-  init.value.ba += d.segment<3>(12);
+  init.value = estimator::boxplus(init.value, d);
   return init;
 }
 

@@ -30,9 +30,6 @@ struct InitialEstimate {
   estimator::Matrix15d P0{estimator::Matrix15d::Zero()};  // [δθ δp δv δbg δba]
 };
 
-/// P0 of VioEstimator::initialize for an IMU orientation q_GtoI.
-estimator::Matrix15d initial_covariance(const Eigen::Vector4d& q_GtoI, const estimator::InitSigmas& sigmas);
-
 /// x̂0 and P0 from the true state (q, p, v and the true biases of `truth`).
 InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioOptions& options,
                                  uint64_t perturb_seed);

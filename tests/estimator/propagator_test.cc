@@ -24,29 +24,18 @@ ImuValue test_state() {
   return x;
 }
 
-// x ⊞ δ with the estimator's error convention.
-ImuValue boxplus(const ImuValue& x, const Eigen::Matrix<double, 15, 1>& d) {
-  ImuValue y = x;
-  y.q_GtoI = quat_boxplus(x.q_GtoI, d.segment<3>(0));
-  y.p_IinG += d.segment<3>(3);
-  y.v_IinG += d.segment<3>(6);
-  y.bg += d.segment<3>(9);
-  y.ba += d.segment<3>(12);
-  return y;
-}
-
-// y ⊟ x: δ with y = x ⊞ δ.
-Eigen::Matrix<double, 15, 1> boxminus(const ImuValue& y, const ImuValue& x) {
-  Eigen::Matrix<double, 15, 1> d;
-  d.segment<3>(0) = -log_so3(quat_to_rot(y.q_GtoI) * quat_to_rot(x.q_GtoI).transpose());
-  d.segment<3>(3) = y.p_IinG - x.p_IinG;
-  d.segment<3>(6) = y.v_IinG - x.v_IinG;
-  d.segment<3>(9) = y.bg - x.bg;
-  d.segment<3>(12) = y.ba - x.ba;
-  return d;
-}
-
 }  // namespace
+
+TEST_CASE("IMU state: x ⊞ (y ⊟ x) = y and (x ⊞ δ) ⊟ x = δ", "[propagator]") {
+  const ImuValue x = test_state();
+  Eigen::Matrix<double, 15, 1> d;
+  for (int i = 0; i < 15; ++i) d(i) = 0.05 * (i - 7);
+  const ImuValue y = boxplus(x, d);
+  CHECK((boxminus(y, x) - d).cwiseAbs().maxCoeff() < 1e-12);
+  // The orientation part is the estimator's left error: R_y = Exp(−δθ) R_x.
+  CHECK((quat_to_rot(y.q_GtoI) - exp_so3(-d.head<3>()) * quat_to_rot(x.q_GtoI)).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((boxplus(x, boxminus(y, x)).to_vector() - y.to_vector()).cwiseAbs().maxCoeff() < 1e-12);
+}
 
 TEST_CASE("Gamma integrals match numerical quadrature", "[propagator]") {
   for (double scale : {1e-6, 0.3, 8.0}) {

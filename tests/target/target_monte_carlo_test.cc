@@ -183,7 +183,7 @@ TEST_CASE("Monte-Carlo: joint IMU + local target covariance matches Phi P Phi^T 
   errors.reserve(N);
   for (int i = 0; i < N; ++i) {
     const Eigen::VectorXd e0 = L0 * g.vec(27);
-    ImuValue it = test::imu_boxplus(imu0, e0.head<15>());
+    ImuValue it = estimator::boxplus(imu0, e0.head<15>());
     const TargetValue xlt = boxplus(xl0, Vector12d(e0.tail<12>()));
     const Eigen::Matrix3d R_GtoI0 = quat_to_rot(it.q_GtoI);
     TruthTarget t{xlt.R_RtoT() * R_GtoI0, it.p_IinG + R_GtoI0.transpose() * xlt.p_TinR, xlt.v_TinT, xlt.w_TinT};
@@ -204,7 +204,7 @@ TEST_CASE("Monte-Carlo: joint IMU + local target covariance matches Phi P Phi^T 
     lt.v_TinT = t.v;
     lt.w_TinT = t.w;
     Eigen::VectorXd e(27);
-    e << test::imu_boxminus(it, imu), boxminus(lt, xl);
+    e << estimator::boxminus(it, imu), boxminus(lt, xl);
     errors.push_back(e);
   }
   check_consistency(errors, P, 0.1);

@@ -124,7 +124,7 @@ TEST_CASE("local step: Phi_TT and Phi_TI equal central finite differences", "[ta
         return boxminus(step(imu, boxplus(x, Vector12d(d))), s.x);
       });
       const Eigen::MatrixXd NI = central_diff(15, [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
-        return boxminus(step(test::imu_boxplus(imu, Eigen::Matrix<double, 15, 1>(d)), x), s.x);
+        return boxminus(step(estimator::boxplus(imu, Eigen::Matrix<double, 15, 1>(d)), x), s.x);
       });
       INFO("rate " << rate << " dt " << dt);
       CHECK(rel_err(s.Phi_TT, NT) < 1e-7);

@@ -31,26 +31,6 @@ inline estimator::ImuValue sample_imu() {
   return x;
 }
 
-inline estimator::ImuValue imu_boxplus(const estimator::ImuValue& x, const Eigen::Matrix<double, 15, 1>& d) {
-  estimator::ImuValue y = x;
-  y.q_GtoI = quat_boxplus(x.q_GtoI, d.segment<3>(0));
-  y.p_IinG += d.segment<3>(3);
-  y.v_IinG += d.segment<3>(6);
-  y.bg += d.segment<3>(9);
-  y.ba += d.segment<3>(12);
-  return y;
-}
-
-inline Eigen::Matrix<double, 15, 1> imu_boxminus(const estimator::ImuValue& y, const estimator::ImuValue& x) {
-  Eigen::Matrix<double, 15, 1> d;
-  d.segment<3>(0) = -log_so3(quat_to_rot(y.q_GtoI) * quat_to_rot(x.q_GtoI).transpose());
-  d.segment<3>(3) = y.p_IinG - x.p_IinG;
-  d.segment<3>(6) = y.v_IinG - x.v_IinG;
-  d.segment<3>(9) = y.bg - x.bg;
-  d.segment<3>(12) = y.ba - x.ba;
-  return d;
-}
-
 /// Central differences: column i = (f(+ε e_i) − f(−ε e_i)) / 2ε, where f
 /// returns an error-state vector (already ⊟ the nominal output).
 inline Eigen::MatrixXd central_diff(int n_in, const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
