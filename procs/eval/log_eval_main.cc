@@ -117,8 +117,15 @@ int run(int argc, const char* const* argv) {
                 static_cast<long long>(tc.bad_covariance));
     for (const auto& [name, ts] : {std::pair<const char*, const eval::ErrorSummary&>{"in IMU  ", r.target_in_imu},
                                    std::pair<const char*, const eval::ErrorSummary&>{"in world", r.target_in_world}}) {
-      std::printf("target %s: position RMSE %.5f m  orientation RMSE %.4f deg  NEES position %.2f  orientation %.2f\n",
-                  name, ts.rmse_position_m, ts.rmse_orientation_deg, ts.nees_position, ts.nees_orientation);
+      // TARGET_STATE carries the covariance of its representation only
+      // (local: in IMU, global: in world); the other frame has no NEES.
+      std::printf("target %s: position RMSE %.5f m  orientation RMSE %.4f deg  ", name, ts.rmse_position_m,
+                  ts.rmse_orientation_deg);
+      if (std::isnan(ts.nees_position)) {
+        std::printf("NEES n/a (no covariance in this frame on the message)\n");
+      } else {
+        std::printf("NEES position %.2f  orientation %.2f\n", ts.nees_position, ts.nees_orientation);
+      }
     }
   }
 
