@@ -63,77 +63,39 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
       r.first_malformed = "event " + std::to_string(ev.eventnum) + " on " + ev.channel + ": " + why;
     }
   };
+  // Decodes *ev as Msg, converts it and hands it to `use`; a message that
+  // does not decode or convert counts as malformed in *counter.
+  auto consume = [&](auto msg, const lcm::LogEvent& ev, int64_t* counter, auto use) {
+    std::string why;
+    if (!decode(ev, &msg, &why)) {
+      malformed(counter, ev, why);
+      return;
+    }
+    try {
+      use(from_lcm(msg));
+    } catch (const std::invalid_argument& e) {
+      malformed(counter, ev, e.what());
+    }
+  };
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++r.events;
-    std::string why;
     if (ev->channel == options.state_channel) {
-      nav_state_t msg;
-      if (!decode(*ev, &msg, &why)) {
-        malformed(&r.malformed_states, *ev, why);
-        continue;
-      }
-      try {
-        matcher.add_state(from_lcm(msg));
-      } catch (const std::invalid_argument& e) {
-        malformed(&r.malformed_states, *ev, e.what());
-      }
+      consume(nav_state_t{}, *ev, &r.malformed_states, [&](const NavState& x) { matcher.add_state(x); });
     } else if (!options.target_channel.empty() && ev->channel == options.target_channel) {
-      target_state_t msg;
-      if (!decode(*ev, &msg, &why)) {
-        malformed(&r.malformed_targets, *ev, why);
-        continue;
-      }
-      try {
-        matcher.add_target(from_lcm(msg));
-      } catch (const std::invalid_argument& e) {
-        malformed(&r.malformed_targets, *ev, e.what());
-      }
+      consume(target_state_t{}, *ev, &r.malformed_targets, [&](const TargetStateEstimate& x) { matcher.add_target(x); });
     } else if (scale_on && ev->channel == options.scale_channel) {
-      scale_estimate_t msg;
-      if (!decode(*ev, &msg, &why)) {
-        malformed(&r.malformed_scale, *ev, why);
-        continue;
-      }
-      try {
-        estimates.push_back(from_lcm(msg));
-      } catch (const std::invalid_argument& e) {
-        malformed(&r.malformed_scale, *ev, e.what());
-      }
+      consume(scale_estimate_t{}, *ev, &r.malformed_scale, [&](const scale::ScaleResult& x) { estimates.push_back(x); });
     } else if (scale_on && ev->channel == options.metric_channel) {
-      metric_object_pose_t msg;
-      if (!decode(*ev, &msg, &why)) {
-        malformed(&r.malformed_scale, *ev, why);
-        continue;
-      }
-      try {
-        metric_poses.push_back(from_lcm(msg));
-      } catch (const std::invalid_argument& e) {
-        malformed(&r.malformed_scale, *ev, e.what());
-      }
+      consume(metric_object_pose_t{}, *ev, &r.malformed_scale,
+              [&](const scale::ObjectPoseInWorld& x) { metric_poses.push_back(x); });
     } else if (scale_on && !options.object_state_channel.empty() && ev->channel == options.object_state_channel) {
-      target_state_t msg;
-      if (!decode(*ev, &msg, &why)) {
-        malformed(&r.malformed_scale, *ev, why);
-        continue;
-      }
-      try {
-        object_states.push_back(from_lcm(msg));
-      } catch (const std::invalid_argument& e) {
-        malformed(&r.malformed_scale, *ev, e.what());
-      }
+      consume(target_state_t{}, *ev, &r.malformed_scale,
+              [&](const TargetStateEstimate& x) { object_states.push_back(x); });
     } else if (ev->channel == options.truth_channel) {
-      ground_truth_t msg;
-      if (!decode(*ev, &msg, &why)) {
-        malformed(&r.malformed_truths, *ev, why);
-        continue;
-      }
-      try {
-        const GroundTruth truth = from_lcm(msg);
+      consume(ground_truth_t{}, *ev, &r.malformed_truths, [&](const GroundTruth& truth) {
         if (scale_on && truth.has_target) target_truths.emplace(truth.utime, truth);
         matcher.add_truth(truth);
-      } catch (const std::invalid_argument& e) {
-        malformed(&r.malformed_truths, *ev, e.what());
-      }
+      });
     }
   }
   r.samples = matcher.match(&r.counts);
