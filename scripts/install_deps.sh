@@ -5,7 +5,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config ccache
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev   # LCM (pkg-config needs glib)
   libeigen3-dev libopencv-dev libceres-dev libserialport-dev catch2
   libyaml-cpp-dev                                    # configuration files
