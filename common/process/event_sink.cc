@@ -1,5 +1,6 @@
 #include "common/process/event_sink.h"
 
+#include <algorithm>
 #include <thread>
 
 #include "common/time/utime.h"
@@ -44,6 +45,30 @@ void LcmSink::write(const std::string& channel, int64_t utime, const void* data,
   if (now >= next_heartbeat_) {
     process_.publish_heartbeat();
     next_heartbeat_ = now + std::chrono::seconds(1);
+  }
+}
+
+void add_sink_options(ArgParser& args) {
+  args.add_option("speed", "FACTOR", "real-time factor when publishing; 0 = as fast as possible", "1");
+  args.add_option("start-delay", "SECONDS", "wait before the first message (lets subscribers start)", "0");
+  args.add_option("log", "FILE", "write an LCM log file instead of publishing (as fast as possible)");
+  args.add_option("linger", "SECONDS", "stay alive this long after the last message (lets consumers drain their queues)",
+                  "0");
+}
+
+std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime) {
+  const ArgParser& args = process.args();
+  const double speed = args.get_double("speed");
+  if (speed < 0.0) throw ArgError(process.name() + ": --speed must be >= 0, got " + args.get("speed"));
+  if (args.given("log")) return std::make_unique<LogFileSink>(args.get("log"));
+  return std::make_unique<LcmSink>(process, speed, first_utime, args.get_double("start-delay"));
+}
+
+void ProgressLog::update(double played_s) {
+  const int decile = static_cast<int>(10.0 * played_s / std::max(span_s_, 1e-9));
+  if (decile > last_decile_) {
+    last_decile_ = decile;
+    log_info("progress ", 10 * decile, "% (", played_s, " s)");
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -48,6 +49,26 @@ class LcmSink : public EventSink {
   int64_t first_utime_;
   std::chrono::steady_clock::time_point wall_start_;
   std::chrono::steady_clock::time_point next_heartbeat_;
+};
+
+/// Declares the output options every driver shares: --speed, --start-delay,
+/// --log, --linger.
+void add_sink_options(ArgParser& args);
+
+/// The sink those options ask for: the --log file if given, else LCM paced
+/// by --speed with `first_utime` leaving after --start-delay. Throws
+/// ArgError for a negative --speed.
+std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime);
+
+/// Logs "progress N% (t s)" each time another tenth of a run is played.
+class ProgressLog {
+ public:
+  explicit ProgressLog(double span_s) : span_s_(span_s) {}
+  void update(double played_s);
+
+ private:
+  double span_s_;
+  int last_decile_{0};
 };
 
 /// Stays alive `seconds` after the last message (or until a stop signal), so

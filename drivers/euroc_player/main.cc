@@ -32,15 +32,9 @@ int run(int argc, const char* const* argv) {
   process.args().add_option("duration", "SECONDS", "play this long from --start; 0 = to the last stereo pair", "0");
   process.args().add_option("imu-lead", "SECONDS",
                             "IMU and ground truth from this long before the first played pair", "1");
-  process.args().add_option("speed", "FACTOR", "real-time factor when publishing; 0 = as fast as possible", "1");
-  process.args().add_option("start-delay", "SECONDS", "wait before the first message (lets subscribers start)", "0");
-  process.args().add_option("log", "FILE", "write an LCM log file instead of publishing (as fast as possible)");
-  process.args().add_option("linger", "SECONDS",
-                            "stay alive this long after the last message (lets consumers drain their queues)", "0");
+  vimot::add_sink_options(process.args());
   if (!process.init(argc, argv)) return 0;
   if (!process.args().given("dataset")) throw vimot::ArgError("vimot-euroc-player: --dataset DIR is required");
-  const double speed = process.args().get_double("speed");
-  if (speed < 0.0) throw vimot::ArgError("vimot-euroc-player: --speed must be >= 0, got " + process.args().get("speed"));
 
   vimot::euroc::PlayerOptions options;
   options.dataset = process.args().get("dataset");
@@ -57,13 +51,7 @@ int run(int argc, const char* const* argv) {
   const std::string right_channel = process.channel("cam_right", "CAM_RIGHT");
   const std::string truth_channel = process.channel("ground_truth", "GROUND_TRUTH");
 
-  std::unique_ptr<vimot::EventSink> sink;
-  if (process.args().given("log")) {
-    sink = std::make_unique<vimot::LogFileSink>(process.args().get("log"));
-  } else {
-    sink = std::make_unique<vimot::LcmSink>(process, speed, player.first_utime(),
-                                            process.args().get_double("start-delay"));
-  }
+  const std::unique_ptr<vimot::EventSink> sink = vimot::make_sink(process, player.first_utime());
   log_info(s.mav0, ": ", s.stereo_pairs, " stereo pairs ", s.width, "x", s.height, " over ",
            vimot::utime_to_seconds(s.span_end_utime - s.span_start_utime), " s, ", s.imu_samples, " IMU samples, ",
            s.groundtruth_poses, " ground-truth poses",
@@ -74,8 +62,7 @@ int run(int argc, const char* const* argv) {
   }
 
   int64_t counts[3] = {0, 0, 0};
-  int last_decile = 0;
-  const double span = vimot::utime_to_seconds(player.last_utime() - player.first_utime());
+  vimot::ProgressLog progress(vimot::utime_to_seconds(player.last_utime() - player.first_utime()));
   while (!process.stop_requested()) {
     const std::optional<vimot::euroc::PlayerEvent> event = player.next();
     if (!event) break;
@@ -95,12 +82,7 @@ int run(int argc, const char* const* argv) {
       utime = truth->utime;
       ++counts[2];
     }
-    const double played = vimot::utime_to_seconds(utime - player.first_utime());
-    const int decile = static_cast<int>(10.0 * played / std::max(span, 1e-9));
-    if (decile > last_decile) {
-      last_decile = decile;
-      log_info("progress ", 10 * decile, "% (", played, " s)");
-    }
+    progress.update(vimot::utime_to_seconds(utime - player.first_utime()));
   }
   log_info(process.stop_requested() ? "stopped early: " : "done: ", counts[0], " on ", imu_channel, ", ", counts[1],
            " on ", left_channel, " and ", right_channel, ", ", counts[2], " on ", truth_channel);

@@ -20,38 +20,26 @@ int run(int argc, const char* const* argv) {
                          /*config_required=*/true);
   process.args().add_option("seed", "N", "noise seed (overrides the config's seed)");
   process.args().add_option("duration", "SECONDS", "simulate only this long (overrides the config)");
-  process.args().add_option("speed", "FACTOR", "real-time factor when publishing; 0 = as fast as possible", "1");
-  process.args().add_option("start-delay", "SECONDS", "wait before the first message (lets subscribers start)", "0");
-  process.args().add_option("log", "FILE", "write an LCM log file instead of publishing (as fast as possible)");
-  process.args().add_option("linger", "SECONDS",
-                            "stay alive this long after the last message (lets consumers drain their queues)", "0");
+  vimot::add_sink_options(process.args());
   if (!process.init(argc, argv)) return 0;
 
   vimot::sim::SimConfig config = vimot::sim::from_config(process.config());
   if (process.args().given("seed")) config.seed = static_cast<uint64_t>(process.args().get_int("seed"));
   if (process.args().given("duration")) config.duration = process.args().get_double("duration");
-  const double speed = process.args().get_double("speed");
-  if (speed < 0.0) throw vimot::ArgError("vimot-sim: --speed must be >= 0, got " + process.args().get("speed"));
 
   vimot::sim::Simulator sim(config);
   const std::string imu_channel = process.channel("imu", "IMU");
   const std::string features_channel = process.channel("features", "FEATURES");
   const std::string truth_channel = process.channel("ground_truth", "GROUND_TRUTH");
 
-  std::unique_ptr<vimot::EventSink> sink;
-  if (process.args().given("log")) {
-    sink = std::make_unique<vimot::LogFileSink>(process.args().get("log"));
-  } else {
-    sink = std::make_unique<vimot::LcmSink>(process, speed, sim.start_utime(),
-                                            process.args().get_double("start-delay"));
-  }
+  const std::unique_ptr<vimot::EventSink> sink = vimot::make_sink(process, sim.start_utime());
   log_info("scenario ", vimot::sim::to_string(config.scenario), ", seed ", config.seed, ", ", sim.duration(),
            " s, path ", sim.path_length(), " m, ", sim.imu_sample_count(), " IMU samples, ",
            sim.camera_frame_count(), " camera frames",
            process.args().given("log") ? ", writing " + process.args().get("log") : "");
 
   int64_t counts[3] = {0, 0, 0};
-  int last_decile = 0;
+  vimot::ProgressLog progress(sim.duration());
   while (!process.stop_requested()) {
     const std::optional<vimot::sim::SimEvent> event = sim.next();
     if (!event) break;
@@ -69,11 +57,7 @@ int run(int argc, const char* const* argv) {
       utime = truth->utime;
       ++counts[2];
     }
-    const int decile = static_cast<int>(10.0 * sim.sim_time(utime) / std::max(sim.duration(), 1e-9));
-    if (decile > last_decile) {
-      last_decile = decile;
-      log_info("progress ", 10 * decile, "% (", sim.sim_time(utime), " s)");
-    }
+    progress.update(sim.sim_time(utime));
   }
   log_info(process.stop_requested() ? "stopped early: " : "done: ", counts[0], " on ", imu_channel, ", ", counts[1],
            " on ", features_channel, ", ", counts[2], " on ", truth_channel);

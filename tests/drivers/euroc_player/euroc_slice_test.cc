@@ -2,14 +2,10 @@
 // order, timestamps and values against the dataset's own CSV files, read
 // here by an independent parser. Exits with ctest's skip code (77) when
 // VIMOT_DATA_DIR is unset or has no slice.
-#define CATCH_CONFIG_RUNNER
-#include <catch2/catch.hpp>
+#include "tests/drivers/euroc_player/slice_test_main.h"
 
 #include <Eigen/Geometry>
-#include <cstdlib>
 #include <fstream>
-#include <iostream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -23,8 +19,6 @@ using vimot::euroc::EurocPlayer;
 using vimot::euroc::PlayerEvent;
 using vimot::euroc::PlayerOptions;
 using vimot::euroc::StereoFrame;
-
-std::string g_slice;  // .../euroc_v101_micro
 
 // First column (ns) of every data row of an ASL CSV.
 std::vector<long long> csv_times(const std::string& path) {
@@ -51,8 +45,8 @@ std::vector<PlayerEvent> play_all(EurocPlayer& player) {
 
 PlayerOptions slice_options() {
   PlayerOptions o;
-  o.dataset = g_slice;
-  o.groundtruth_file = g_slice + "/groundtruth/V1_01_easy.csv";
+  o.dataset = slice_dir();
+  o.groundtruth_file = slice_dir() + "/groundtruth/V1_01_easy.csv";
   return o;
 }
 
@@ -111,8 +105,8 @@ TEST_CASE("events are time ordered, IMU and truth before a frame of the same tim
 }
 
 TEST_CASE("timestamps and values are the CSV's", "[euroc][data]") {
-  const std::vector<long long> cam0 = csv_times(g_slice + "/mav0/cam0/data.csv");
-  const std::vector<long long> imu = csv_times(g_slice + "/mav0/imu0/data.csv");
+  const std::vector<long long> cam0 = csv_times(slice_dir() + "/mav0/cam0/data.csv");
+  const std::vector<long long> imu = csv_times(slice_dir() + "/mav0/imu0/data.csv");
   REQUIRE(cam0.size() == 95u);
   EurocPlayer player(slice_options());
   std::size_t frame = 0, sample = 0;
@@ -122,8 +116,8 @@ TEST_CASE("timestamps and values are the CSV's", "[euroc][data]") {
       REQUIRE(frame < cam0.size());
       CHECK(f->timestamp_ns == cam0[frame]);
       CHECK(f->utime == (cam0[frame] + 500) / 1000);
-      CHECK(f->left_path == g_slice + "/mav0/cam0/data/" + std::to_string(cam0[frame]) + ".png");
-      CHECK(f->right_path == g_slice + "/mav0/cam1/data/" + std::to_string(cam0[frame]) + ".png");
+      CHECK(f->left_path == slice_dir() + "/mav0/cam0/data/" + std::to_string(cam0[frame]) + ".png");
+      CHECK(f->right_path == slice_dir() + "/mav0/cam1/data/" + std::to_string(cam0[frame]) + ".png");
       ++frame;
     } else if (const auto* m = std::get_if<vimot::ImuData>(&*e)) {
       CHECK(m->utime == (imu[sample] + 500) / 1000);
@@ -182,7 +176,7 @@ TEST_CASE("without a ground-truth file the slice plays no truth (it has no state
   EurocPlayer player(o);
   CHECK(player.summary().groundtruth_file.empty());
   CHECK(player.summary().groundtruth_poses == 0);
-  o.groundtruth_file = g_slice + "/groundtruth/V1_01_easy.csv";
+  o.groundtruth_file = slice_dir() + "/groundtruth/V1_01_easy.csv";
   o.use_groundtruth = false;
   CHECK(EurocPlayer(o).summary().groundtruth_poses == 0);
 }
@@ -231,18 +225,4 @@ TEST_CASE("images load lazily as 752x480 grey and convert to image_t byte for by
   CHECK(msg.size == 752 * 480);
   CHECK(msg.data[752 * 100 + 200] == images.left.at<uint8_t>(100, 200));
   CHECK(cv::norm(vimot::grey_from_lcm_image(msg), images.left, cv::NORM_INF) == 0.0);
-}
-
-int main(int argc, char** argv) {
-  const char* root = std::getenv("VIMOT_DATA_DIR");
-  if (root == nullptr) {
-    std::cout << "VIMOT_DATA_DIR not set: skipping the EuRoC slice tests\n";
-    return 77;
-  }
-  g_slice = std::string(root) + "/euroc_v101_micro";
-  if (!std::ifstream(g_slice + "/mav0/cam0/data.csv").good()) {
-    std::cout << "VIMOT_DATA_DIR=" << root << " has no euroc_v101_micro/mav0/cam0/data.csv: skipping\n";
-    return 77;
-  }
-  return Catch::Session().run(argc, argv);
 }

@@ -2,13 +2,9 @@
 // estimator configured by config/vins_euroc.yaml (init.mode: static) must
 // initialise at rest, with roll/pitch and gyro bias matching the slice's
 // ground truth. Exits with ctest's skip code (77) without VIMOT_DATA_DIR.
-#define CATCH_CONFIG_RUNNER
-#include <catch2/catch.hpp>
+#include "tests/drivers/euroc_player/slice_test_main.h"
 
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <iostream>
 #include <map>
 #include <vector>
 
@@ -19,8 +15,6 @@
 #include "drivers/euroc_player/euroc_player.h"
 
 namespace {
-
-std::string g_slice;
 
 double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));
@@ -35,8 +29,8 @@ TEST_CASE("static initialisation on the slice's IMU agrees with its ground truth
   vimot::estimator::VioEstimator estimator(options);
 
   vimot::euroc::PlayerOptions player_options;
-  player_options.dataset = g_slice;
-  player_options.groundtruth_file = g_slice + "/groundtruth/V1_01_easy.csv";
+  player_options.dataset = slice_dir();
+  player_options.groundtruth_file = slice_dir() + "/groundtruth/V1_01_easy.csv";
   vimot::euroc::EurocPlayer player(player_options);
   std::map<int64_t, vimot::GroundTruth> truth;
   std::vector<vimot::ImuData> fed;
@@ -127,18 +121,4 @@ TEST_CASE("static initialisation on the slice's IMU agrees with its ground truth
   WARN("static init on the slice: tilt error " << error_vs_truth * 180 / M_PI << " deg (b_a alone predicts "
                                                << tilt_from_bias * 180 / M_PI << " deg), gyro bias error "
                                                << bg_error << " rad/s");
-}
-
-int main(int argc, char** argv) {
-  const char* root = std::getenv("VIMOT_DATA_DIR");
-  if (root == nullptr) {
-    std::cout << "VIMOT_DATA_DIR not set: skipping the EuRoC static initialisation test\n";
-    return 77;
-  }
-  g_slice = std::string(root) + "/euroc_v101_micro";
-  if (!std::ifstream(g_slice + "/mav0/imu0/data.csv").good()) {
-    std::cout << "VIMOT_DATA_DIR=" << root << " has no euroc_v101_micro/mav0/imu0/data.csv: skipping\n";
-    return 77;
-  }
-  return Catch::Session().run(argc, argv);
 }
