@@ -98,8 +98,6 @@ class EurocPlayer {
   std::optional<PlayerEvent> next();
   /// Back to the first event.
   void rewind() { position_ = 0; }
-  std::size_t size() const { return events_.size(); }
-  std::size_t position() const { return position_; }
   int64_t first_utime() const;
   int64_t last_utime() const;
 
