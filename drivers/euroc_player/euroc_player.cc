@@ -65,13 +65,6 @@ std::vector<CsvRow> read_csv(const std::string& path) {
   throw EurocError(path + ":" + std::to_string(row.line) + ": " + what + " in '" + row.text + "'");
 }
 
-void expect_fields(const std::string& path, const CsvRow& row, const std::vector<std::size_t>& allowed,
-                   const std::string& layout) {
-  if (std::find(allowed.begin(), allowed.end(), row.fields.size()) == allowed.end()) {
-    row_error(path, row, "expected " + layout + ", got " + std::to_string(row.fields.size()) + " fields");
-  }
-}
-
 // Timestamps are integers of ~1.4e18 ns: beyond a double's 53 bits, so they
 // are parsed as integers, never through a double.
 int64_t parse_ns(const std::string& path, const CsvRow& row) {
@@ -100,11 +93,26 @@ Eigen::Vector3d parse_vec3(const std::string& path, const CsvRow& row, std::size
                          parse_number(path, row, first + 2));
 }
 
-void expect_increasing(const std::string& path, const CsvRow& row, int64_t previous_ns, int64_t ns) {
-  if (ns <= previous_ns) {
-    row_error(path, row, "timestamp " + std::to_string(ns) + " does not increase (previous " +
-                             std::to_string(previous_ns) + ")");
+// The data rows of an ASL CSV with a strictly increasing ns timestamp first
+// and one of `field_counts` fields; parse(row, ns) makes the entry.
+template <typename Entry, typename Parse>
+std::vector<Entry> read_timed_csv(const std::string& path, const std::vector<std::size_t>& field_counts,
+                                  const std::string& layout, Parse parse) {
+  std::vector<Entry> entries;
+  int64_t previous = -1;
+  for (const CsvRow& row : read_csv(path)) {
+    if (std::find(field_counts.begin(), field_counts.end(), row.fields.size()) == field_counts.end()) {
+      row_error(path, row, "expected " + layout + ", got " + std::to_string(row.fields.size()) + " fields");
+    }
+    const int64_t ns = parse_ns(path, row);
+    if (ns <= previous) {
+      row_error(path, row,
+                "timestamp " + std::to_string(ns) + " does not increase (previous " + std::to_string(previous) + ")");
+    }
+    previous = ns;
+    entries.push_back(parse(row, ns));
   }
+  return entries;
 }
 
 struct CameraEntry {
@@ -115,17 +123,11 @@ struct CameraEntry {
 
 std::vector<CameraEntry> read_camera_csv(const std::string& cam_dir) {
   const std::string path = cam_dir + "/data.csv";
-  std::vector<CameraEntry> entries;
-  int64_t previous = -1;
-  for (const CsvRow& row : read_csv(path)) {
-    expect_fields(path, row, {2}, "2 fields 'timestamp [ns],filename'");
-    const int64_t ns = parse_ns(path, row);
-    expect_increasing(path, row, previous, ns);
-    previous = ns;
-    if (row.fields[1].empty()) row_error(path, row, "empty file name");
-    entries.push_back({ns, cam_dir + "/data/" + row.fields[1], row.line});
-  }
-  return entries;
+  return read_timed_csv<CameraEntry>(path, {2}, "2 fields 'timestamp [ns],filename'",
+                                     [&](const CsvRow& row, int64_t ns) {
+                                       if (row.fields[1].empty()) row_error(path, row, "empty file name");
+                                       return CameraEntry{ns, cam_dir + "/data/" + row.fields[1], row.line};
+                                     });
 }
 
 struct TimedImu {
@@ -134,20 +136,14 @@ struct TimedImu {
 };
 
 std::vector<TimedImu> read_imu_csv(const std::string& path) {
-  std::vector<TimedImu> samples;
-  int64_t previous = -1;
-  for (const CsvRow& row : read_csv(path)) {
-    expect_fields(path, row, {7}, "7 fields 'timestamp [ns],wx,wy,wz,ax,ay,az'");
-    TimedImu s;
-    s.ns = parse_ns(path, row);
-    expect_increasing(path, row, previous, s.ns);
-    previous = s.ns;
-    s.imu.utime = ns_to_utime(s.ns);
-    s.imu.w_IinI = parse_vec3(path, row, 1);
-    s.imu.a_IinI = parse_vec3(path, row, 4);
-    samples.push_back(s);
-  }
-  return samples;
+  return read_timed_csv<TimedImu>(path, {7}, "7 fields 'timestamp [ns],wx,wy,wz,ax,ay,az'",
+                                  [&](const CsvRow& row, int64_t ns) {
+                                    TimedImu s{ns, {}};
+                                    s.imu.utime = ns_to_utime(ns);
+                                    s.imu.w_IinI = parse_vec3(path, row, 1);
+                                    s.imu.a_IinI = parse_vec3(path, row, 4);
+                                    return s;
+                                  });
 }
 
 struct TimedTruth {
@@ -156,32 +152,26 @@ struct TimedTruth {
 };
 
 std::vector<TimedTruth> read_groundtruth_csv(const std::string& path) {
-  std::vector<TimedTruth> poses;
-  int64_t previous = -1;
-  for (const CsvRow& row : read_csv(path)) {
-    expect_fields(path, row, {8, 11, 17},
-                  "8, 11 or 17 fields 'time[ns],px,py,pz,qw,qx,qy,qz[,vx,vy,vz[,bwx,bwy,bwz,bax,bay,baz]]'");
-    TimedTruth t;
-    t.ns = parse_ns(path, row);
-    expect_increasing(path, row, previous, t.ns);
-    previous = t.ns;
-    t.truth.utime = ns_to_utime(t.ns);
-    t.truth.p_IinG = parse_vec3(path, row, 1);
-    // EuRoC writes the Hamilton q_ItoG scalar first (w, x, y, z).
-    const Eigen::Vector4d q_hamilton(parse_number(path, row, 5), parse_number(path, row, 6),
-                                     parse_number(path, row, 7), parse_number(path, row, 4));
-    if (std::abs(q_hamilton.norm() - 1.0) > 1e-3) {
-      row_error(path, row, "quaternion norm " + std::to_string(q_hamilton.norm()) + " is not 1");
-    }
-    t.truth.q_GtoI = quat_normalize(hamilton_ItoG_to_jpl_GtoI(q_hamilton));
-    if (row.fields.size() >= 11) t.truth.v_IinG = parse_vec3(path, row, 8);
-    if (row.fields.size() == 17) {
-      t.truth.bias_gyro = parse_vec3(path, row, 11);
-      t.truth.bias_accel = parse_vec3(path, row, 14);
-    }
-    poses.push_back(t);
-  }
-  return poses;
+  return read_timed_csv<TimedTruth>(
+      path, {8, 11, 17}, "8, 11 or 17 fields 'time[ns],px,py,pz,qw,qx,qy,qz[,vx,vy,vz[,bwx,bwy,bwz,bax,bay,baz]]'",
+      [&](const CsvRow& row, int64_t ns) {
+        TimedTruth t{ns, {}};
+        t.truth.utime = ns_to_utime(ns);
+        t.truth.p_IinG = parse_vec3(path, row, 1);
+        // EuRoC writes the Hamilton q_ItoG scalar first (w, x, y, z).
+        const Eigen::Vector4d q_hamilton(parse_number(path, row, 5), parse_number(path, row, 6),
+                                         parse_number(path, row, 7), parse_number(path, row, 4));
+        if (std::abs(q_hamilton.norm() - 1.0) > 1e-3) {
+          row_error(path, row, "quaternion norm " + std::to_string(q_hamilton.norm()) + " is not 1");
+        }
+        t.truth.q_GtoI = quat_normalize(hamilton_ItoG_to_jpl_GtoI(q_hamilton));
+        if (row.fields.size() >= 11) t.truth.v_IinG = parse_vec3(path, row, 8);
+        if (row.fields.size() == 17) {
+          t.truth.bias_gyro = parse_vec3(path, row, 11);
+          t.truth.bias_accel = parse_vec3(path, row, 14);
+        }
+        return t;
+      });
 }
 
 // Image size from an ASL camera sensor.yaml ("resolution: [w, h]").
