@@ -1,0 +1,384 @@
+#include "common/sim/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace vimot {
+namespace sim {
+
+namespace {
+
+// Random streams (see derive_seed): textures from map_seed, the rest from seed.
+constexpr uint64_t kStreamFloorTexture = 21;
+constexpr uint64_t kStreamWallTexture = 22;
+constexpr uint64_t kStreamCeilingTexture = 23;
+constexpr uint64_t kStreamTargetTexture = 24;
+constexpr uint64_t kStreamImageNoise = 25;
+constexpr uint64_t kStreamExposure = 26;
+
+// Clearance (m) the room keeps below and above the camera path, and the
+// spacing (s) at which the path is sampled to check it.
+constexpr double kRoomClearance = 1.0;
+constexpr double kPathSampleDt = 0.1;
+
+// Constant shading of the room's surfaces (x walls, y walls, floor,
+// ceiling): neighbouring surfaces differ, as under real lighting.
+constexpr float kShadeWallX = 0.9f;
+constexpr float kShadeWallY = 0.8f;
+constexpr float kShadeFloor = 1.0f;
+constexpr float kShadeCeiling = 0.75f;
+// Target faces: ambient + Lambert term under a fixed light from above.
+constexpr float kTargetAmbient = 0.45f;
+constexpr float kTargetDiffuse = 0.55f;
+const Eigen::Vector3d kLightDirG = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
+
+// The target texture: a pattern with stronger contrast than the scene's and
+// a different scale range, so its features describe it rather than the room.
+PatternStyle target_style(int cell) {
+  PatternStyle style;
+  style.min_size = 3.0;
+  style.max_size = 0.5 * cell;
+  style.contrast = 70.0;
+  style.coverage = 0.45;
+  return style;
+}
+
+// Cells of the target texture: 4 x 2, one per face (4 x 2 >= 6).
+constexpr int kTargetCellsX = 4;
+constexpr int kTargetCellsY = 2;
+
+std::string fmt(double v) {
+  std::ostringstream ss;
+  ss.precision(6);
+  ss << v;
+  return ss.str();
+}
+
+Eigen::Vector3d camera_centre(const Eigen::Matrix4d& T_ItoG, const CameraCalibration& calib) {
+  const Eigen::Vector3d p_CinI = -calib.R_ItoC.transpose() * calib.p_IinC;
+  return T_ItoG.topLeftCorner<3, 3>() * p_CinI + T_ItoG.topRightCorner<3, 1>();
+}
+
+Eigen::Matrix4d pose_of(const SplineState& state) { return make_se3(state.R_BtoG, state.p_BinG); }
+
+// log2 of a positive, finite x to about 0.005: exponent plus a quadratic in
+// the mantissa. Only picks mip levels, several times cheaper than std::log2.
+inline float fast_log2(float x) {
+  uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const float exponent = static_cast<float>(static_cast<int>(bits >> 23) - 127);
+  bits = (bits & 0x007FFFFFu) | 0x3F800000u;
+  float m;  // mantissa in [1, 2)
+  std::memcpy(&m, &bits, sizeof m);
+  return exponent + (-0.34484843f * m + 2.02466578f) * m - 0.67487759f;
+}
+
+// Mip level of a pixel whose centre ray meets a surface at camera depth t:
+// footprint = distance · pixel angle / sqrt(cos incidence), in texels.
+// `angle_norm` = pixel angle · |ray|, `cos_num` = |ray · normal| (so
+// cos incidence = cos_num · inv_norm). Squared, so there is no sqrt.
+inline float mip_level(float t, float angle_norm, float inv_norm, float cos_num, float inv_texel) {
+  const float f = t * angle_norm * inv_texel;
+  return 0.5f * fast_log2(f * f / (cos_num * inv_norm));
+}
+
+}  // namespace
+
+Renderer::Renderer(const Simulator& sim) : sim_(sim), config_(sim.config().render) {
+  validate(sim.config());
+  const SimConfig& sc = sim.config();
+  const Eigen::AlignedBox2d& ws = sim.workspace();
+  if (ws.isEmpty() || !(ws.sizes().minCoeff() > 0.0)) {
+    throw std::invalid_argument("Renderer: the scenario's workspace (the room's floor) is empty");
+  }
+  // Room height: the static map's walls, grown to keep clearance around the path.
+  double z_lo = 0.0, z_hi = sc.map.wall_height;
+  const int n = std::max(2, static_cast<int>(std::ceil(sim.duration() / kPathSampleDt)) + 1);
+  for (int k = 0; k < n; ++k) {
+    const double t = sim.duration() * static_cast<double>(k) / static_cast<double>(n - 1);
+    const Eigen::Matrix4d T_ItoG = pose_of(sim.robot_state(t));
+    for (const CameraCalibration& calib : sim.cameras()) {
+      const Eigen::Vector3d p = camera_centre(T_ItoG, calib);
+      if (!ws.contains(Eigen::Vector2d(p.head<2>()))) {
+        throw std::invalid_argument("Renderer: camera at (" + fmt(p.x()) + ", " + fmt(p.y()) + ") m at t = " +
+                                    fmt(t) + " s leaves the room (the workspace rectangle); grow map.margin or "
+                                    "the mono room");
+      }
+      z_lo = std::min(z_lo, p.z() - kRoomClearance);
+      z_hi = std::max(z_hi, p.z() + kRoomClearance);
+    }
+  }
+  room_ = Eigen::AlignedBox3d(Eigen::Vector3d(ws.min().x(), ws.min().y(), z_lo),
+                              Eigen::Vector3d(ws.max().x(), ws.max().y(), z_hi));
+  if (sim.has_target()) target_half_ = 0.5 * sc.target.size;
+
+  build_textures();
+  for (const CameraModel& model : sim.camera_models()) build_rays(model);
+  std::mt19937_64 rng(derive_seed(sc.seed, kStreamExposure));
+  exposure_phase_ = 2.0 * M_PI * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  noise_seed_ = derive_seed(sc.seed, kStreamImageNoise);
+}
+
+void Renderer::build_textures() {
+  const uint64_t map_seed = sim_.config().map_seed;
+  const int size = config_.texture_size;
+  auto scene = [&](uint64_t stream) {
+    if (config_.scene_texture == SurfaceTexture::kCheckerboard) {
+      return make_checkerboard_texture(size, size,
+                                       static_cast<int>(std::lround(config_.checker_square / config_.texel_size)));
+    }
+    return make_pattern_texture(size, size, PatternStyle(), derive_seed(map_seed, stream));
+  };
+  floor_ = MipTexture(scene(kStreamFloorTexture));
+  wall_ = MipTexture(scene(kStreamWallTexture));
+  ceiling_ = MipTexture(scene(kStreamCeilingTexture));
+  room_faces_ = {Face{&wall_, kShadeWallX},  Face{&wall_, kShadeWallX},   Face{&wall_, kShadeWallY},
+                 Face{&wall_, kShadeWallY},  Face{&floor_, kShadeFloor}, Face{&ceiling_, kShadeCeiling}};
+
+  if (!sim_.has_target()) return;
+  target_cell_ = config_.target_texture_size;
+  target_texel_ = static_cast<float>(sim_.config().target.size.maxCoeff() / target_cell_);
+  if (config_.target_texture == SurfaceTexture::kCheckerboard) {
+    // Squares start at each face's corner: one checkerboard per cell.
+    const cv::Mat cell = make_checkerboard_texture(
+        target_cell_, target_cell_, static_cast<int>(std::lround(config_.checker_square / target_texel_)));
+    cv::Mat atlas(kTargetCellsY * target_cell_, kTargetCellsX * target_cell_, CV_8UC1);
+    for (int cy = 0; cy < kTargetCellsY; ++cy) {
+      for (int cx = 0; cx < kTargetCellsX; ++cx) {
+        cell.copyTo(atlas(cv::Rect(cx * target_cell_, cy * target_cell_, target_cell_, target_cell_)));
+      }
+    }
+    target_ = MipTexture(atlas);
+  } else {
+    target_ = MipTexture(make_pattern_texture(kTargetCellsX * target_cell_, kTargetCellsY * target_cell_,
+                                              target_style(target_cell_),
+                                              derive_seed(map_seed, kStreamTargetTexture)));
+  }
+}
+
+void Renderer::build_rays(const CameraModel& model) {
+  const CameraCalibration& calib = model.calibration();
+  CameraRays cam;
+  cam.width = calib.width;
+  cam.height = calib.height;
+  cam.rays.resize(static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height));
+  std::vector<Eigen::Vector3d> unit(cam.rays.size());
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      Eigen::Vector2d n;
+      try {
+        n = model.undistort(Eigen::Vector2d(u, v));
+      } catch (const std::runtime_error& e) {
+        throw std::runtime_error("Renderer: camera " + std::to_string(cameras_.size()) + " cannot undistort pixel (" +
+                                 std::to_string(u) + ", " + std::to_string(v) + "): " + e.what() +
+                                 "; check its distortion coefficients");
+      }
+      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u);
+      const Eigen::Vector3d r(n.x(), n.y(), 1.0);
+      unit[i] = r.normalized();
+      cam.rays[i] = PixelRay{static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(1.0 / r.norm()),
+                             0.0f};
+    }
+  }
+  // Angular size: square root of the solid angle the pixel spans, from the
+  // differences of neighbouring rays (central inside, one-sided at the border).
+  auto at = [&](int u, int v) -> const Eigen::Vector3d& {
+    return unit[static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u)];
+  };
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const int u0 = std::max(u - 1, 0), u1 = std::min(u + 1, cam.width - 1);
+      const int v0 = std::max(v - 1, 0), v1 = std::min(v + 1, cam.height - 1);
+      const Eigen::Vector3d du = (at(u1, v) - at(u0, v)) / static_cast<double>(u1 - u0);
+      const Eigen::Vector3d dv = (at(u, v1) - at(u, v0)) / static_cast<double>(v1 - v0);
+      PixelRay& ray =
+          cam.rays[static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u)];
+      ray.angle_norm = static_cast<float>(std::sqrt(du.cross(dv).norm())) / ray.inv_norm;
+    }
+  }
+  cameras_.push_back(std::move(cam));
+}
+
+std::vector<RenderedView> Renderer::render(int64_t utime) const {
+  if (utime < sim_.start_utime() || utime > sim_.end_utime()) {
+    throw std::invalid_argument("Renderer::render: utime " + std::to_string(utime) + " outside the run [" +
+                                std::to_string(sim_.start_utime()) + ", " + std::to_string(sim_.end_utime()) + "]");
+  }
+  const double t = sim_.sim_time(utime);
+  const Eigen::Matrix4d T_ItoG = pose_of(sim_.robot_state(t));
+  const std::optional<SplineState> target = sim_.target_state(t);
+  const Eigen::Matrix4d T_TtoG = target ? pose_of(*target) : Eigen::Matrix4d::Identity();
+  const double gain = std::exp(config_.exposure_amplitude *
+                               std::sin(2.0 * M_PI * config_.exposure_frequency_hz * t + exposure_phase_));
+  std::vector<RenderedView> views;
+  for (int cam = 0; cam < static_cast<int>(cameras_.size()); ++cam) {
+    views.push_back(render_camera(cam, utime, T_ItoG, target ? &T_TtoG : nullptr, gain));
+  }
+  return views;
+}
+
+RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix4d& T_ItoG,
+                                     const Eigen::Matrix4d* T_TtoG, double gain) const {
+  const CameraCalibration& calib = sim_.cameras()[static_cast<std::size_t>(cam)];
+  const CameraRays& rays = cameras_[static_cast<std::size_t>(cam)];
+  const Eigen::Matrix3d R_CtoG = T_ItoG.topLeftCorner<3, 3>() * calib.R_ItoC.transpose();
+  const Eigen::Vector3d p_CinG = camera_centre(T_ItoG, calib);
+  if (!room_.contains(p_CinG)) {
+    throw std::runtime_error("Renderer: camera " + std::to_string(cam) + " is outside the room at utime " +
+                             std::to_string(utime));
+  }
+  const Eigen::Matrix3f R = R_CtoG.cast<float>();
+
+  // Room: per axis, the offsets from the camera to the lower and upper walls.
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = static_cast<float>(room_.min()(k) - p_CinG(k));
+    hi[k] = static_cast<float>(room_.max()(k) - p_CinG(k));
+  }
+  // Texture coordinate of the camera centre per world axis, reduced modulo
+  // the texture period so floats keep their precision far from the origin.
+  const double inv_texel = 1.0 / config_.texel_size;
+  float origin_tex[3];
+  for (int k = 0; k < 3; ++k) {
+    origin_tex[k] = static_cast<float>(std::fmod(p_CinG(k) * inv_texel - 0.5, config_.texture_size));
+  }
+  const float inv_texel_f = static_cast<float>(inv_texel);
+
+  // Target in the camera frame: rays in T, and the box of normalized
+  // coordinates its projection can cover (all rays tested when it straddles
+  // the camera plane, none when it is behind).
+  Eigen::Matrix3f R_CtoT = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f o_T = Eigen::Vector3f::Zero();
+  Eigen::Vector3f half = target_half_.cast<float>();
+  float face_shade[3][2] = {};  // [axis][0: + face, 1: - face]
+  float bx0 = 1.0f, bx1 = -1.0f, by0 = 1.0f, by1 = -1.0f;  // empty
+  if (T_TtoG != nullptr) {
+    const Eigen::Matrix3d R_TtoG = T_TtoG->topLeftCorner<3, 3>();
+    const Eigen::Vector3d p_TinG = T_TtoG->topRightCorner<3, 1>();
+    R_CtoT = (R_TtoG.transpose() * R_CtoG).cast<float>();
+    o_T = (R_TtoG.transpose() * (p_CinG - p_TinG)).cast<float>();
+    for (int k = 0; k < 3; ++k) {
+      const double lambert = std::max(0.0, R_TtoG.col(k).dot(kLightDirG));
+      const double lambert_neg = std::max(0.0, -R_TtoG.col(k).dot(kLightDirG));
+      face_shade[k][0] = static_cast<float>(kTargetAmbient + kTargetDiffuse * lambert);
+      face_shade[k][1] = static_cast<float>(kTargetAmbient + kTargetDiffuse * lambert_neg);
+    }
+    const Eigen::Matrix3d R_GtoC = R_CtoG.transpose();
+    int in_front = 0;
+    float x0 = std::numeric_limits<float>::max(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner(c & 1 ? target_half_.x() : -target_half_.x(),
+                                   c & 2 ? target_half_.y() : -target_half_.y(),
+                                   c & 4 ? target_half_.z() : -target_half_.z());
+      const Eigen::Vector3d p = R_GtoC * (R_TtoG * corner + p_TinG - p_CinG);
+      if (p.z() > 1e-6) {
+        ++in_front;
+        x0 = std::min(x0, static_cast<float>(p.x() / p.z()));
+        x1 = std::max(x1, static_cast<float>(p.x() / p.z()));
+        y0 = std::min(y0, static_cast<float>(p.y() / p.z()));
+        y1 = std::max(y1, static_cast<float>(p.y() / p.z()));
+      }
+    }
+    if (in_front == 8) {
+      bx0 = x0, bx1 = x1, by0 = y0, by1 = y1;
+    } else if (in_front > 0) {
+      bx0 = by0 = -std::numeric_limits<float>::infinity();
+      bx1 = by1 = std::numeric_limits<float>::infinity();
+    }
+  }
+  const float target_inv_texel = target_texel_ > 0.0f ? 1.0f / target_texel_ : 0.0f;
+  const float cell = static_cast<float>(target_cell_);
+
+  RenderedView view;
+  view.camera_id = cam;
+  view.utime = utime;
+  cv::Mat radiance(rays.height, rays.width, CV_32FC1);
+  view.mask = cv::Mat::zeros(rays.height, rays.width, CV_8UC1);
+  int mu0 = rays.width, mu1 = -1, mv0 = rays.height, mv1 = -1;
+  const float g = static_cast<float>(gain);
+
+  for (int v = 0; v < rays.height; ++v) {
+    const PixelRay* ray = rays.rays.data() + static_cast<std::size_t>(v) * static_cast<std::size_t>(rays.width);
+    float* out = radiance.ptr<float>(v);
+    uint8_t* mask = view.mask.ptr<uint8_t>(v);
+    for (int u = 0; u < rays.width; ++u, ++ray) {
+      const float rx = ray->x, ry = ray->y;
+      // Ray direction in G, parametrised by camera depth (camera z = 1).
+      const float d[3] = {R(0, 0) * rx + R(0, 1) * ry + R(0, 2), R(1, 0) * rx + R(1, 1) * ry + R(1, 2),
+                          R(2, 0) * rx + R(2, 1) * ry + R(2, 2)};
+      // Room (seen from inside): the nearest wall along the ray.
+      // Distance to wall k is num_k / |d_k| with num_k >= 0; compare by
+      // cross-multiplying, divide once.
+      float num[3], den[3];
+      for (int k = 0; k < 3; ++k) {
+        num[k] = d[k] > 0.0f ? hi[k] : -lo[k];
+        den[k] = std::abs(d[k]);
+      }
+      int axis = num[1] * den[0] < num[0] * den[1] ? 1 : 0;
+      if (num[2] * den[axis] < num[axis] * den[2]) axis = 2;
+      const float t_room = num[axis] / den[axis];
+
+      if (rx >= bx0 && rx <= bx1 && ry >= by0 && ry <= by1) {
+        // Slab test against the target box, in T.
+        const float dt[3] = {R_CtoT(0, 0) * rx + R_CtoT(0, 1) * ry + R_CtoT(0, 2),
+                             R_CtoT(1, 0) * rx + R_CtoT(1, 1) * ry + R_CtoT(1, 2),
+                             R_CtoT(2, 0) * rx + R_CtoT(2, 1) * ry + R_CtoT(2, 2)};
+        float t_in = 0.0f, t_out = t_room;
+        int face_axis = -1;
+        for (int k = 0; k < 3 && t_in <= t_out; ++k) {
+          const float inv = 1.0f / dt[k];  // ±inf for a ray parallel to the slab
+          float t1 = (-half(k) - o_T(k)) * inv, t2 = (half(k) - o_T(k)) * inv;
+          if (t1 > t2) std::swap(t1, t2);
+          if (!(t2 >= t1)) t1 = t2 = std::numeric_limits<float>::infinity();  // NaN: on the slab plane
+          if (t1 > t_in) t_in = t1, face_axis = k;
+          t_out = std::min(t_out, t2);
+        }
+        if (face_axis >= 0 && t_in <= t_out) {
+          // Entered through face (face_axis, side): side 0 is the + face.
+          const int side = dt[face_axis] < 0.0f ? 0 : 1;
+          const int face = 2 * face_axis + side;
+          const int a1 = (face_axis + 1) % 3, a2 = (face_axis + 2) % 3;
+          const float cx = static_cast<float>((face % kTargetCellsX) * target_cell_);
+          const float cy = static_cast<float>((face / kTargetCellsX) * target_cell_);
+          const float p1 = o_T(a1) + t_in * dt[a1] + half(a1), p2 = o_T(a2) + t_in * dt[a2] + half(a2);
+          const float s = std::clamp(p1 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cx;
+          const float tt = std::clamp(p2 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cy;
+          const float lod = mip_level(t_in, ray->angle_norm, ray->inv_norm, std::abs(dt[face_axis]), target_inv_texel);
+          out[u] = g * face_shade[face_axis][side] * target_.sample(s, tt, lod);
+          mask[u] = 255;
+          mu0 = std::min(mu0, u), mu1 = std::max(mu1, u);
+          mv0 = std::min(mv0, v), mv1 = std::max(mv1, v);
+          continue;
+        }
+      }
+
+      // Texture coordinates on the wall hit: the two other world axes.
+      const int a1 = axis == 0 ? 1 : 0, a2 = axis == 2 ? 1 : 2;
+      const float s = origin_tex[a1] + t_room * d[a1] * inv_texel_f;
+      const float tt = origin_tex[a2] + t_room * d[a2] * inv_texel_f;
+      const float lod = mip_level(t_room, ray->angle_norm, ray->inv_norm, den[axis], inv_texel_f);
+      const Face& face = room_faces_[static_cast<std::size_t>(2 * axis + (d[axis] > 0.0f ? 1 : 0))];
+      out[u] = g * face.shade * face.texture->sample(s, tt, lod);
+    }
+  }
+
+  if (config_.noise_sigma > 0.0) {
+    cv::RNG rng(derive_seed(noise_seed_ ^ static_cast<uint64_t>(utime), static_cast<uint64_t>(cam)));
+    cv::Mat noise(radiance.size(), CV_32FC1);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, config_.noise_sigma);
+    radiance += noise;
+  }
+  radiance.convertTo(view.image, CV_8U);  // rounds and saturates
+  view.visible = mu1 >= 0;
+  if (view.visible) view.box = Eigen::Vector4d(mu0, mv0, mu1 - mu0 + 1, mv1 - mv0 + 1);
+  return view;
+}
+
+}  // namespace sim
+}  // namespace vimot
