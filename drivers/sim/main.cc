@@ -1,7 +1,9 @@
 // vimot-sim: the simulator as a sensor driver. Publishes IMU, FEATURES and
 // GROUND_TRUTH on LCM at real time or any speed factor, or writes them
-// straight into an LCM log file as fast as the CPU allows. The simulation
-// itself is common/sim (no LCM); this file only converts and paces.
+// straight into an LCM log file as fast as the CPU allows. With --render it
+// publishes rendered camera images (and the true target mask and box)
+// instead of FEATURES. The simulation and the rendering are common/sim (no
+// LCM); this file only converts and paces.
 #include <chrono>
 #include <thread>
 #include <variant>
@@ -10,8 +12,12 @@
 
 #include "common/process/lcm_conversions.h"
 #include "common/process/process.h"
+#include "common/sim/renderer.h"
 #include "common/sim/simulator.h"
 #include "common/time/utime.h"
+#include "vimot/image_t.hpp"
+#include "vimot/mask_t.hpp"
+#include "vimot/target_box_t.hpp"
 
 namespace {
 
@@ -79,6 +85,43 @@ class LcmSink : public EventSink {
   std::chrono::steady_clock::time_point next_heartbeat_;
 };
 
+vimot::image_t to_image_msg(const vimot::sim::RenderedView& view) {
+  vimot::image_t msg;
+  msg.utime = view.utime;
+  msg.width = view.image.cols;
+  msg.height = view.image.rows;
+  msg.row_stride = view.image.cols;
+  msg.pixelformat = vimot::image_t::PIXEL_FORMAT_GRAY;
+  msg.data.assign(view.image.datastart, view.image.dataend);  // continuous CV_8UC1
+  msg.size = static_cast<int32_t>(msg.data.size());
+  msg.nmetadata = 0;
+  return msg;
+}
+
+vimot::mask_t to_mask_msg(const vimot::sim::RenderedView& view) {
+  vimot::mask_t msg;
+  msg.utime = view.utime;
+  msg.camera_id = static_cast<int8_t>(view.camera_id);
+  msg.width = view.mask.cols;
+  msg.height = view.mask.rows;
+  msg.data.assign(view.mask.datastart, view.mask.dataend);
+  msg.size = static_cast<int32_t>(msg.data.size());
+  return msg;
+}
+
+// The true box as a mask filter would report a perfect detection: raw =
+// filtered, no coasting, zero covariance and velocity.
+vimot::target_box_t to_box_msg(const vimot::sim::RenderedView& view) {
+  vimot::target_box_t msg{};
+  msg.utime = view.utime;
+  msg.camera_id = static_cast<int8_t>(view.camera_id);
+  msg.raw_valid = view.visible;
+  msg.filtered_valid = view.visible;
+  for (int k = 0; k < 4; ++k) msg.raw_box[k] = msg.filtered_box[k] = view.box(k);
+  msg.frames_since_raw = 0;
+  return msg;
+}
+
 template <typename Msg>
 void emit(EventSink& sink, const std::string& channel, const Msg& msg) {
   std::vector<uint8_t> buffer(static_cast<std::size_t>(msg.getEncodedSize()));
@@ -89,13 +132,17 @@ void emit(EventSink& sink, const std::string& channel, const Msg& msg) {
 int run(int argc, const char* const* argv) {
   vimot::Process process("vimot-sim",
                          "Simulates a scenario (config/sim_*.yaml) and publishes IMU, FEATURES and\n"
-                         "GROUND_TRUTH on LCM, paced by --speed, or writes them to an LCM log (--log).",
+                         "GROUND_TRUTH on LCM, paced by --speed, or writes them to an LCM log (--log).\n"
+                         "--render: rendered images on CAM_LEFT / CAM_RIGHT and the true target mask and\n"
+                         "box (TARGET_MASK_TRUTH, TARGET_BOX_TRUTH) per camera instead of FEATURES.",
                          /*config_required=*/true);
   process.args().add_option("seed", "N", "noise seed (overrides the config's seed)");
   process.args().add_option("duration", "SECONDS", "simulate only this long (overrides the config)");
   process.args().add_option("speed", "FACTOR", "real-time factor when publishing; 0 = as fast as possible", "1");
   process.args().add_option("start-delay", "SECONDS", "wait before the first message (lets subscribers start)", "0");
   process.args().add_option("log", "FILE", "write an LCM log file instead of publishing (as fast as possible)");
+  process.args().add_flag("render", "publish rendered images, target masks and boxes instead of FEATURES");
+  process.args().add_flag("with-features", "with --render, publish FEATURES too");
   process.args().add_option("linger", "SECONDS",
                             "stay alive this long after the last message (lets consumers drain their queues)", "0");
   if (!process.init(argc, argv)) return 0;
@@ -110,6 +157,17 @@ int run(int argc, const char* const* argv) {
   const std::string imu_channel = process.channel("imu", "IMU");
   const std::string features_channel = process.channel("features", "FEATURES");
   const std::string truth_channel = process.channel("ground_truth", "GROUND_TRUTH");
+  const bool render = process.args().given("render");
+  if (process.args().given("with-features") && !render) {
+    throw vimot::ArgError("vimot-sim: --with-features needs --render");
+  }
+  const bool publish_features = !render || process.args().given("with-features");
+  const std::string camera_channels[2] = {process.channel("cam_left", "CAM_LEFT"),
+                                          process.channel("cam_right", "CAM_RIGHT")};
+  const std::string mask_channel = process.channel("target_mask_truth", "TARGET_MASK_TRUTH");
+  const std::string box_channel = process.channel("target_box_truth", "TARGET_BOX_TRUTH");
+  std::unique_ptr<vimot::sim::Renderer> renderer;
+  if (render) renderer = std::make_unique<vimot::sim::Renderer>(sim);
 
   std::unique_ptr<EventSink> sink;
   if (process.args().given("log")) {
@@ -122,7 +180,7 @@ int run(int argc, const char* const* argv) {
            sim.camera_frame_count(), " camera frames",
            process.args().given("log") ? ", writing " + process.args().get("log") : "");
 
-  int64_t counts[3] = {0, 0, 0};
+  int64_t counts[4] = {0, 0, 0, 0};
   int last_decile = 0;
   while (!process.stop_requested()) {
     const std::optional<vimot::sim::SimEvent> event = sim.next();
@@ -133,9 +191,19 @@ int run(int argc, const char* const* argv) {
       utime = imu->utime;
       ++counts[0];
     } else if (const auto* frame = std::get_if<vimot::CameraFrame>(&*event)) {
-      emit(*sink, features_channel, vimot::to_lcm(*frame));
+      if (publish_features) {
+        emit(*sink, features_channel, vimot::to_lcm(*frame));
+        ++counts[1];
+      }
+      if (renderer) {
+        for (const vimot::sim::RenderedView& view : renderer->render(frame->utime)) {
+          emit(*sink, camera_channels[view.camera_id], to_image_msg(view));
+          emit(*sink, mask_channel, to_mask_msg(view));
+          emit(*sink, box_channel, to_box_msg(view));
+          ++counts[3];
+        }
+      }
       utime = frame->utime;
-      ++counts[1];
     } else if (const auto* truth = std::get_if<vimot::GroundTruth>(&*event)) {
       emit(*sink, truth_channel, vimot::to_lcm(*truth));
       utime = truth->utime;
@@ -148,7 +216,8 @@ int run(int argc, const char* const* argv) {
     }
   }
   log_info(process.stop_requested() ? "stopped early: " : "done: ", counts[0], " on ", imu_channel, ", ", counts[1],
-           " on ", features_channel, ", ", counts[2], " on ", truth_channel);
+           " on ", features_channel, ", ", counts[2], " on ", truth_channel,
+           render ? ", " + std::to_string(counts[3]) + " rendered images (+ masks, boxes)" : std::string());
   const auto linger_end = std::chrono::steady_clock::now() +
                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                               std::chrono::duration<double>(process.args().get_double("linger")));
