@@ -88,6 +88,54 @@ inline float mip_level(float t, float angle_norm, float inv_norm, float cos_num,
   return 0.5f * fast_log2(f * f / (cos_num * inv_norm));
 }
 
+// The camera's view of the room for one frame: R_CtoG (row-major), the
+// offsets from the camera to the lower / upper walls per axis, the texture
+// coordinate of the camera centre per axis, 1 / texel size.
+struct RoomView {
+  float R[9];
+  float lo[3], hi[3];
+  float origin_tex[3];
+  float inv_texel;
+};
+
+// For one image row: where each pixel's ray leaves the room (camera depth
+// t), on which face (2 axis + (upper wall)), the texture coordinates there
+// and the mip level. Branch-free so it vectorizes (see CMakeLists.txt).
+void room_row(const RoomView& view, std::size_t width, const float* __restrict xs, const float* __restrict ys,
+              const float* __restrict inv_norms, const float* __restrict angle_norms, float* __restrict ss,
+              float* __restrict ts, float* __restrict lods, float* __restrict t_rooms, int* __restrict faces) {
+  const float r00 = view.R[0], r01 = view.R[1], r02 = view.R[2], r10 = view.R[3], r11 = view.R[4], r12 = view.R[5],
+              r20 = view.R[6], r21 = view.R[7], r22 = view.R[8];
+  const float lo0 = view.lo[0], lo1 = view.lo[1], lo2 = view.lo[2], hi0 = view.hi[0], hi1 = view.hi[1],
+              hi2 = view.hi[2];
+  const float o0 = view.origin_tex[0], o1 = view.origin_tex[1], o2 = view.origin_tex[2];
+  const float inv_texel_f = view.inv_texel;
+  for (std::size_t u = 0; u < width; ++u) {
+    const float rx = xs[u], ry = ys[u];
+    // Ray direction in G, parametrised by camera depth (camera z = 1).
+    const float d0 = r00 * rx + r01 * ry + r02, d1 = r10 * rx + r11 * ry + r12, d2 = r20 * rx + r21 * ry + r22;
+    // The room seen from inside: wall k is num_k / |d_k| away (num_k >=
+    // 0); pick the nearest by cross-multiplying, divide once.
+    const float n0 = d0 > 0.0f ? hi0 : -lo0, n1 = d1 > 0.0f ? hi1 : -lo1, n2 = d2 > 0.0f ? hi2 : -lo2;
+    const float a0 = std::abs(d0), a1 = std::abs(d1), a2 = std::abs(d2);
+    const bool y_wall = n1 * a0 < n0 * a1;
+    float num = y_wall ? n1 : n0, den = y_wall ? a1 : a0, d_axis = y_wall ? d1 : d0;
+    const bool z_wall = n2 * den < num * a2;
+    num = z_wall ? n2 : num;
+    den = z_wall ? a2 : den;
+    d_axis = z_wall ? d2 : d_axis;
+    const float t = num / den;
+    // Texture coordinates: the two world axes along the wall hit.
+    const float w0 = o0 + t * d0 * inv_texel_f, w1 = o1 + t * d1 * inv_texel_f, w2 = o2 + t * d2 * inv_texel_f;
+    const bool x_wall = !(y_wall | z_wall);
+    ss[u] = x_wall ? w1 : w0;
+    ts[u] = z_wall ? w1 : w2;
+    lods[u] = mip_level(t, angle_norms[u], inv_norms[u], den, inv_texel_f);
+    t_rooms[u] = t;
+    faces[u] = 2 * (z_wall ? 2 : (y_wall ? 1 : 0)) + (d_axis > 0.0f ? 1 : 0);
+  }
+}
+
 }  // namespace
 
 Renderer::Renderer(const Simulator& sim) : sim_(sim), config_(sim.config().render) {
@@ -167,8 +215,12 @@ void Renderer::build_rays(const CameraModel& model) {
   CameraRays cam;
   cam.width = calib.width;
   cam.height = calib.height;
-  cam.rays.resize(static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height));
-  std::vector<Eigen::Vector3d> unit(cam.rays.size());
+  const std::size_t count = static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
+  cam.x.resize(count);
+  cam.y.resize(count);
+  cam.inv_norm.resize(count);
+  cam.angle_norm.resize(count);
+  std::vector<Eigen::Vector3d> unit(count);
   for (int v = 0; v < cam.height; ++v) {
     for (int u = 0; u < cam.width; ++u) {
       Eigen::Vector2d n;
@@ -182,8 +234,9 @@ void Renderer::build_rays(const CameraModel& model) {
       const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u);
       const Eigen::Vector3d r(n.x(), n.y(), 1.0);
       unit[i] = r.normalized();
-      cam.rays[i] = PixelRay{static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(1.0 / r.norm()),
-                             0.0f};
+      cam.x[i] = static_cast<float>(n.x());
+      cam.y[i] = static_cast<float>(n.y());
+      cam.inv_norm[i] = static_cast<float>(1.0 / r.norm());
     }
   }
   // Angular size: square root of the solid angle the pixel spans, from the
@@ -197,9 +250,8 @@ void Renderer::build_rays(const CameraModel& model) {
       const int v0 = std::max(v - 1, 0), v1 = std::min(v + 1, cam.height - 1);
       const Eigen::Vector3d du = (at(u1, v) - at(u0, v)) / static_cast<double>(u1 - u0);
       const Eigen::Vector3d dv = (at(u, v1) - at(u, v0)) / static_cast<double>(v1 - v0);
-      PixelRay& ray =
-          cam.rays[static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u)];
-      ray.angle_norm = static_cast<float>(std::sqrt(du.cross(dv).norm())) / ray.inv_norm;
+      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u);
+      cam.angle_norm[i] = static_cast<float>(std::sqrt(du.cross(dv).norm())) / cam.inv_norm[i];
     }
   }
   cameras_.push_back(std::move(cam));
@@ -241,12 +293,16 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
     lo[k] = static_cast<float>(room_.min()(k) - p_CinG(k));
     hi[k] = static_cast<float>(room_.max()(k) - p_CinG(k));
   }
-  // Texture coordinate of the camera centre per world axis, reduced modulo
-  // the texture period so floats keep their precision far from the origin.
+  // Texture coordinate of the camera centre per world axis, counted from the
+  // last whole texture period below the room: every hit point then has a
+  // coordinate >= -0.5 (what MipTexture::sample needs), small enough for
+  // float precision, and the textures stay aligned to the world axes.
   const double inv_texel = 1.0 / config_.texel_size;
+  const double period = config_.texture_size * config_.texel_size;
   float origin_tex[3];
   for (int k = 0; k < 3; ++k) {
-    origin_tex[k] = static_cast<float>(std::fmod(p_CinG(k) * inv_texel - 0.5, config_.texture_size));
+    const double base = std::floor(room_.min()(k) / period) * period;
+    origin_tex[k] = static_cast<float>((p_CinG(k) - base) * inv_texel - 0.5);
   }
   const float inv_texel_f = static_cast<float>(inv_texel);
 
@@ -303,33 +359,38 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
   int mu0 = rays.width, mu1 = -1, mv0 = rays.height, mv1 = -1;
   const float g = static_cast<float>(gain);
 
+  // Per row: the room hit of every pixel (branch-free, vectorizable), then
+  // the target where its box of rays is, then the texture lookups.
+  const std::size_t width = static_cast<std::size_t>(rays.width);
+  std::vector<float> tex_s(width), tex_t(width), tex_lod(width), t_room(width);
+  std::vector<int> room_face(width);
+  RoomView room;
+  for (int k = 0; k < 9; ++k) room.R[k] = R(k / 3, k % 3);
+  for (int k = 0; k < 3; ++k) {
+    room.hi[k] = hi[k];
+    room.lo[k] = lo[k];
+    room.origin_tex[k] = origin_tex[k];
+  }
+  room.inv_texel = inv_texel_f;
   for (int v = 0; v < rays.height; ++v) {
-    const PixelRay* ray = rays.rays.data() + static_cast<std::size_t>(v) * static_cast<std::size_t>(rays.width);
+    const std::size_t row = static_cast<std::size_t>(v) * width;
+    const float* xs = rays.x.data() + row;
+    const float* ys = rays.y.data() + row;
+    const float* inv_norms = rays.inv_norm.data() + row;
+    const float* angle_norms = rays.angle_norm.data() + row;
+    room_row(room, width, xs, ys, inv_norms, angle_norms, tex_s.data(), tex_t.data(), tex_lod.data(), t_room.data(),
+             room_face.data());
+
     float* out = radiance.ptr<float>(v);
     uint8_t* mask = view.mask.ptr<uint8_t>(v);
-    for (int u = 0; u < rays.width; ++u, ++ray) {
-      const float rx = ray->x, ry = ray->y;
-      // Ray direction in G, parametrised by camera depth (camera z = 1).
-      const float d[3] = {R(0, 0) * rx + R(0, 1) * ry + R(0, 2), R(1, 0) * rx + R(1, 1) * ry + R(1, 2),
-                          R(2, 0) * rx + R(2, 1) * ry + R(2, 2)};
-      // Room (seen from inside): the nearest wall along the ray.
-      // Distance to wall k is num_k / |d_k| with num_k >= 0; compare by
-      // cross-multiplying, divide once.
-      float num[3], den[3];
-      for (int k = 0; k < 3; ++k) {
-        num[k] = d[k] > 0.0f ? hi[k] : -lo[k];
-        den[k] = std::abs(d[k]);
-      }
-      int axis = num[1] * den[0] < num[0] * den[1] ? 1 : 0;
-      if (num[2] * den[axis] < num[axis] * den[2]) axis = 2;
-      const float t_room = num[axis] / den[axis];
-
+    for (int u = 0; u < rays.width; ++u) {
+      const float rx = xs[u], ry = ys[u];
       if (rx >= bx0 && rx <= bx1 && ry >= by0 && ry <= by1) {
         // Slab test against the target box, in T.
         const float dt[3] = {R_CtoT(0, 0) * rx + R_CtoT(0, 1) * ry + R_CtoT(0, 2),
                              R_CtoT(1, 0) * rx + R_CtoT(1, 1) * ry + R_CtoT(1, 2),
                              R_CtoT(2, 0) * rx + R_CtoT(2, 1) * ry + R_CtoT(2, 2)};
-        float t_in = 0.0f, t_out = t_room;
+        float t_in = 0.0f, t_out = t_room[static_cast<std::size_t>(u)];
         int face_axis = -1;
         for (int k = 0; k < 3 && t_in <= t_out; ++k) {
           const float inv = 1.0f / dt[k];  // ±inf for a ray parallel to the slab
@@ -349,7 +410,7 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
           const float p1 = o_T(a1) + t_in * dt[a1] + half(a1), p2 = o_T(a2) + t_in * dt[a2] + half(a2);
           const float s = std::clamp(p1 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cx;
           const float tt = std::clamp(p2 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cy;
-          const float lod = mip_level(t_in, ray->angle_norm, ray->inv_norm, std::abs(dt[face_axis]), target_inv_texel);
+          const float lod = mip_level(t_in, angle_norms[u], inv_norms[u], std::abs(dt[face_axis]), target_inv_texel);
           out[u] = g * face_shade[face_axis][side] * target_.sample(s, tt, lod);
           mask[u] = 255;
           mu0 = std::min(mu0, u), mu1 = std::max(mu1, u);
@@ -357,14 +418,9 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
           continue;
         }
       }
-
-      // Texture coordinates on the wall hit: the two other world axes.
-      const int a1 = axis == 0 ? 1 : 0, a2 = axis == 2 ? 1 : 2;
-      const float s = origin_tex[a1] + t_room * d[a1] * inv_texel_f;
-      const float tt = origin_tex[a2] + t_room * d[a2] * inv_texel_f;
-      const float lod = mip_level(t_room, ray->angle_norm, ray->inv_norm, den[axis], inv_texel_f);
-      const Face& face = room_faces_[static_cast<std::size_t>(2 * axis + (d[axis] > 0.0f ? 1 : 0))];
-      out[u] = g * face.shade * face.texture->sample(s, tt, lod);
+      const std::size_t i = static_cast<std::size_t>(u);
+      const Face& face = room_faces_[static_cast<std::size_t>(room_face[i])];
+      out[u] = g * face.shade * face.texture->sample(tex_s[i], tex_t[i], tex_lod[i]);
     }
   }
 

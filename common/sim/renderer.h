@@ -73,14 +73,12 @@ class Renderer {
   const Eigen::AlignedBox3d& room() const { return room_; }
 
  private:
-  // Per pixel: normalized (undistorted) ray (x, y, 1), 1 / its norm, and the
-  // pixel's angular size (rad, square root of its solid angle) times the norm.
-  struct PixelRay {
-    float x, y, inv_norm, angle_norm;
-  };
+  // Per pixel, row-major (arrays, so the per-row geometry vectorizes): the
+  // normalized (undistorted) ray (x, y, 1), 1 / its norm, and the pixel's
+  // angular size (rad, square root of its solid angle) times the norm.
   struct CameraRays {
     int width{0}, height{0};
-    std::vector<PixelRay> rays;
+    std::vector<float> x, y, inv_norm, angle_norm;
   };
   struct Face {
     const MipTexture* texture{nullptr};

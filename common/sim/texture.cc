@@ -105,7 +105,7 @@ MipTexture::MipTexture(const cv::Mat& level0) {
                                 std::to_string(level0.cols) + " x " + std::to_string(level0.rows));
   }
   cv::Mat current = level0.clone();
-  float scale = 1.0f;
+  float scale = 256.0f;
   while (true) {
     Level level;
     level.image = current;
@@ -113,7 +113,7 @@ MipTexture::MipTexture(const cv::Mat& level0) {
     level.width = current.cols;
     level.height = current.rows;
     level.step = static_cast<int>(current.step[0]);
-    level.scale = scale;
+    level.scale256 = scale;
     levels_.push_back(level);
     if (current.cols <= 4 || current.rows <= 4) break;
     // pyrDown's 5-tap Gaussian, with the texture's own wrap-around as border.

@@ -53,18 +53,22 @@ class MipTexture {
   int height() const { return levels_.empty() ? 0 : levels_[0].height; }
   int level_count() const { return static_cast<int>(levels_.size()); }
 
-  /// Grey value at level-0 coordinate (s, t) for a pixel footprint of 2^lod
-  /// level-0 texels: bilinear in the two nearest levels, linear between
-  /// them; lod <= 0 samples level 0, lod beyond the last level the last.
+  /// Grey value at level-0 coordinate (s, t) >= -0.5 for a pixel footprint
+  /// of 2^lod level-0 texels: bilinear in the two nearest levels, linear
+  /// between them; lod <= 0 samples level 0, lod beyond the last level the
+  /// last. Coordinates must stay below 2^22 texels (8-bit fixed point).
   float sample(float s, float t, float lod) const {
-    if (!(lod > 0.0f)) return bilinear(levels_[0], s, t);
+    constexpr float kUnit = 1.0f / 65536.0f;
+    if (!(lod > 0.0f)) return static_cast<float>(bilinear(levels_[0], s, t)) * kUnit;
     const int last = static_cast<int>(levels_.size()) - 1;
-    if (lod >= static_cast<float>(last)) return bilinear(levels_[static_cast<std::size_t>(last)], s, t);
+    if (lod >= static_cast<float>(last)) {
+      return static_cast<float>(bilinear(levels_[static_cast<std::size_t>(last)], s, t)) * kUnit;
+    }
     const int l = static_cast<int>(lod);
     const float f = lod - static_cast<float>(l);
-    const Level& a = levels_[static_cast<std::size_t>(l)];
-    const Level& b = levels_[static_cast<std::size_t>(l) + 1];
-    return (1.0f - f) * bilinear(a, s, t) + f * bilinear(b, s, t);
+    const float a = static_cast<float>(bilinear(levels_[static_cast<std::size_t>(l)], s, t));
+    const float b = static_cast<float>(bilinear(levels_[static_cast<std::size_t>(l) + 1], s, t));
+    return (a + f * (b - a)) * kUnit;
   }
 
  private:
@@ -73,25 +77,23 @@ class MipTexture {
     const uint8_t* data{nullptr};
     int width{0}, height{0};
     int step{0};
-    float scale{1.0f};  // level-0 coordinate -> this level's coordinate
+    float scale256{256.0f};  // level-0 coordinate -> this level's, in 1/256 texel
   };
-  static float bilinear(const Level& level, float s, float t) {
-    const float x = s * level.scale, y = t * level.scale;
-    const float xf = floor_fast(x), yf = floor_fast(y);
-    const float fx = x - xf, fy = y - yf;
+  // Bilinear value in 1/65536 grey levels, in 8-bit fixed point: no float
+  // conversions per texel. Truncation toward zero of s >= -0.5 still floors
+  // through the arithmetic shift.
+  static int bilinear(const Level& level, float s, float t) {
+    const int xi = static_cast<int>(s * level.scale256), yi = static_cast<int>(t * level.scale256);
+    const int fx = xi & 255, fy = yi & 255;
     // Wrap addressing: the sides are powers of two.
     const int mx = level.width - 1, my = level.height - 1;
-    const int x0 = static_cast<int>(xf) & mx, y0 = static_cast<int>(yf) & my;
+    const int x0 = (xi >> 8) & mx, y0 = (yi >> 8) & my;
     const int x1 = (x0 + 1) & mx, y1 = (y0 + 1) & my;
     const uint8_t* r0 = level.data + static_cast<std::ptrdiff_t>(y0) * level.step;
     const uint8_t* r1 = level.data + static_cast<std::ptrdiff_t>(y1) * level.step;
-    const float top = static_cast<float>(r0[x0]) + fx * static_cast<float>(r0[x1] - r0[x0]);
-    const float bottom = static_cast<float>(r1[x0]) + fx * static_cast<float>(r1[x1] - r1[x0]);
-    return top + fy * (bottom - top);
-  }
-  static float floor_fast(float v) {
-    const float i = static_cast<float>(static_cast<int>(v));
-    return i > v ? i - 1.0f : i;
+    const int top = (r0[x0] << 8) + (r0[x1] - r0[x0]) * fx;
+    const int bottom = (r1[x0] << 8) + (r1[x1] - r1[x0]) * fx;
+    return (top << 8) + (bottom - top) * fy;
   }
 
   std::vector<Level> levels_;
