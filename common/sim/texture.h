@@ -25,8 +25,8 @@ namespace sim {
 struct PatternStyle {
   double min_size{3.0};    // texels, smallest shape of the finest octave
   double max_size{512.0};  // texels, the coarsest octave starts below this
-  double contrast{60.0};   // grey levels, per layer
-  double coverage{0.2};    // fraction of the area each octave covers
+  double contrast{40.0};   // grey levels, per layer
+  double coverage{0.12};   // fraction of the area each octave covers
   double base{128.0};      // grey level the layers add to
 };
 
