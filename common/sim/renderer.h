@@ -64,6 +64,9 @@ class Renderer {
   /// room is empty or the camera path leaves it, std::runtime_error when a
   /// pixel cannot be undistorted.
   explicit Renderer(const Simulator& sim);
+  // The faces point at the renderer's own textures.
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
 
   /// The images of all cameras (index = camera_id) at `utime`, which must
   /// lie in [sim.start_utime(), sim.end_utime()] (std::invalid_argument).
