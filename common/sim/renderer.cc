@@ -285,26 +285,20 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
     throw std::runtime_error("Renderer: camera " + std::to_string(cam) + " is outside the room at utime " +
                              std::to_string(utime));
   }
-  const Eigen::Matrix3f R = R_CtoG.cast<float>();
-
-  // Room: per axis, the offsets from the camera to the lower and upper walls.
-  float lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) {
-    lo[k] = static_cast<float>(room_.min()(k) - p_CinG(k));
-    hi[k] = static_cast<float>(room_.max()(k) - p_CinG(k));
-  }
-  // Texture coordinate of the camera centre per world axis, counted from the
-  // last whole texture period below the room: every hit point then has a
+  // The room from this camera. Texture coordinates count from the last
+  // whole texture period below the room: every hit point then has a
   // coordinate >= -0.5 (what MipTexture::sample needs), small enough for
   // float precision, and the textures stay aligned to the world axes.
-  const double inv_texel = 1.0 / config_.texel_size;
+  RoomView room;
   const double period = config_.texture_size * config_.texel_size;
-  float origin_tex[3];
   for (int k = 0; k < 3; ++k) {
+    room.lo[k] = static_cast<float>(room_.min()(k) - p_CinG(k));
+    room.hi[k] = static_cast<float>(room_.max()(k) - p_CinG(k));
     const double base = std::floor(room_.min()(k) / period) * period;
-    origin_tex[k] = static_cast<float>((p_CinG(k) - base) * inv_texel - 0.5);
+    room.origin_tex[k] = static_cast<float>((p_CinG(k) - base) / config_.texel_size - 0.5);
   }
-  const float inv_texel_f = static_cast<float>(inv_texel);
+  for (int k = 0; k < 9; ++k) room.R[k] = static_cast<float>(R_CtoG(k / 3, k % 3));
+  room.inv_texel = static_cast<float>(1.0 / config_.texel_size);
 
   // Target in the camera frame: rays in T, and the box of normalized
   // coordinates its projection can cover (all rays tested when it straddles
@@ -364,14 +358,6 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
   const std::size_t width = static_cast<std::size_t>(rays.width);
   std::vector<float> tex_s(width), tex_t(width), tex_lod(width), t_room(width);
   std::vector<int> room_face(width);
-  RoomView room;
-  for (int k = 0; k < 9; ++k) room.R[k] = R(k / 3, k % 3);
-  for (int k = 0; k < 3; ++k) {
-    room.hi[k] = hi[k];
-    room.lo[k] = lo[k];
-    room.origin_tex[k] = origin_tex[k];
-  }
-  room.inv_texel = inv_texel_f;
   for (int v = 0; v < rays.height; ++v) {
     const std::size_t row = static_cast<std::size_t>(v) * width;
     const float* xs = rays.x.data() + row;
