@@ -345,13 +345,49 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
   const float target_inv_texel = target_texel_ > 0.0f ? 1.0f / target_texel_ : 0.0f;
   const float cell = static_cast<float>(target_cell_);
 
+  // Radiance of the target along ray (rx, ry, 1) (inside the target's box
+  // of rays) if it is nearer than t_room (camera depth): slab test in T,
+  // then the face's texture.
+  auto in_target_box = [&](float rx, float ry) { return rx >= bx0 && rx <= bx1 && ry >= by0 && ry <= by1; };
+  auto shade_target = [&](float rx, float ry, float inv_norm, float angle_norm, float t_room, float* value) {
+    const float dt[3] = {R_CtoT(0, 0) * rx + R_CtoT(0, 1) * ry + R_CtoT(0, 2),
+                         R_CtoT(1, 0) * rx + R_CtoT(1, 1) * ry + R_CtoT(1, 2),
+                         R_CtoT(2, 0) * rx + R_CtoT(2, 1) * ry + R_CtoT(2, 2)};
+    float t_in = 0.0f, t_out = t_room;
+    int face_axis = -1;
+    for (int k = 0; k < 3 && t_in <= t_out; ++k) {
+      const float inv = 1.0f / dt[k];  // ±inf for a ray parallel to the slab
+      float t1 = (-half(k) - o_T(k)) * inv, t2 = (half(k) - o_T(k)) * inv;
+      if (t1 > t2) std::swap(t1, t2);
+      if (!(t2 >= t1)) t1 = t2 = std::numeric_limits<float>::infinity();  // NaN: on the slab plane
+      if (t1 > t_in) t_in = t1, face_axis = k;
+      t_out = std::min(t_out, t2);
+    }
+    if (face_axis < 0 || t_in > t_out) return false;
+    // Entered through face (face_axis, side): side 0 is the + face.
+    const int side = dt[face_axis] < 0.0f ? 0 : 1;
+    const int face = 2 * face_axis + side;
+    const int a1 = (face_axis + 1) % 3, a2 = (face_axis + 2) % 3;
+    const float cx = static_cast<float>((face % kTargetCellsX) * target_cell_);
+    const float cy = static_cast<float>((face / kTargetCellsX) * target_cell_);
+    const float p1 = o_T(a1) + t_in * dt[a1] + half(a1), p2 = o_T(a2) + t_in * dt[a2] + half(a2);
+    const float s = std::clamp(p1 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cx;
+    const float tt = std::clamp(p2 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cy;
+    const float lod = mip_level(t_in, angle_norm, inv_norm, std::abs(dt[face_axis]), target_inv_texel);
+    *value = face_shade[face_axis][side] * target_.sample(s, tt, lod);
+    return true;
+  };
+  auto shade_room = [this](int face_index, float s, float t, float lod) {
+    const Face& face = room_faces_[static_cast<std::size_t>(face_index)];
+    return face.shade * face.texture->sample(s, t, lod);
+  };
+
   RenderedView view;
   view.camera_id = cam;
   view.utime = utime;
   cv::Mat radiance(rays.height, rays.width, CV_32FC1);
   view.mask = cv::Mat::zeros(rays.height, rays.width, CV_8UC1);
   int mu0 = rays.width, mu1 = -1, mv0 = rays.height, mv1 = -1;
-  const float g = static_cast<float>(gain);
 
   // Per row: the room hit of every pixel (branch-free, vectorizable), then
   // the target where its box of rays is, then the texture lookups.
@@ -366,57 +402,74 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
     const float* angle_norms = rays.angle_norm.data() + row;
     room_row(room, width, xs, ys, inv_norms, angle_norms, tex_s.data(), tex_t.data(), tex_lod.data(), t_room.data(),
              room_face.data());
-
     float* out = radiance.ptr<float>(v);
     uint8_t* mask = view.mask.ptr<uint8_t>(v);
-    for (int u = 0; u < rays.width; ++u) {
-      const float rx = xs[u], ry = ys[u];
-      if (rx >= bx0 && rx <= bx1 && ry >= by0 && ry <= by1) {
-        // Slab test against the target box, in T.
-        const float dt[3] = {R_CtoT(0, 0) * rx + R_CtoT(0, 1) * ry + R_CtoT(0, 2),
-                             R_CtoT(1, 0) * rx + R_CtoT(1, 1) * ry + R_CtoT(1, 2),
-                             R_CtoT(2, 0) * rx + R_CtoT(2, 1) * ry + R_CtoT(2, 2)};
-        float t_in = 0.0f, t_out = t_room[static_cast<std::size_t>(u)];
-        int face_axis = -1;
-        for (int k = 0; k < 3 && t_in <= t_out; ++k) {
-          const float inv = 1.0f / dt[k];  // ±inf for a ray parallel to the slab
-          float t1 = (-half(k) - o_T(k)) * inv, t2 = (half(k) - o_T(k)) * inv;
-          if (t1 > t2) std::swap(t1, t2);
-          if (!(t2 >= t1)) t1 = t2 = std::numeric_limits<float>::infinity();  // NaN: on the slab plane
-          if (t1 > t_in) t_in = t1, face_axis = k;
-          t_out = std::min(t_out, t2);
-        }
-        if (face_axis >= 0 && t_in <= t_out) {
-          // Entered through face (face_axis, side): side 0 is the + face.
-          const int side = dt[face_axis] < 0.0f ? 0 : 1;
-          const int face = 2 * face_axis + side;
-          const int a1 = (face_axis + 1) % 3, a2 = (face_axis + 2) % 3;
-          const float cx = static_cast<float>((face % kTargetCellsX) * target_cell_);
-          const float cy = static_cast<float>((face / kTargetCellsX) * target_cell_);
-          const float p1 = o_T(a1) + t_in * dt[a1] + half(a1), p2 = o_T(a2) + t_in * dt[a2] + half(a2);
-          const float s = std::clamp(p1 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cx;
-          const float tt = std::clamp(p2 * target_inv_texel - 0.5f, 0.0f, cell - 1.0f) + cy;
-          const float lod = mip_level(t_in, angle_norms[u], inv_norms[u], std::abs(dt[face_axis]), target_inv_texel);
-          out[u] = g * face_shade[face_axis][side] * target_.sample(s, tt, lod);
-          mask[u] = 255;
-          mu0 = std::min(mu0, u), mu1 = std::max(mu1, u);
-          mv0 = std::min(mv0, v), mv1 = std::max(mv1, v);
-          continue;
-        }
+    for (std::size_t i = 0; i < width; ++i) {
+      if (in_target_box(xs[i], ys[i]) && shade_target(xs[i], ys[i], inv_norms[i], angle_norms[i], t_room[i], &out[i])) {
+        const int u = static_cast<int>(i);
+        mask[i] = 255;
+        mu0 = std::min(mu0, u), mu1 = std::max(mu1, u);
+        mv0 = std::min(mv0, v), mv1 = std::max(mv1, v);
+      } else {
+        out[i] = shade_room(room_face[i], tex_s[i], tex_t[i], tex_lod[i]);
       }
-      const std::size_t i = static_cast<std::size_t>(u);
-      const Face& face = room_faces_[static_cast<std::size_t>(room_face[i])];
-      out[u] = g * face.shade * face.texture->sample(tex_s[i], tex_t[i], tex_lod[i]);
     }
   }
 
+  // Anti-aliased silhouette: a pixel on the mask's edge (a 4-neighbour on
+  // the other side) averages 4 rays at (±1/4, ±1/4) px, their directions
+  // from the rays' local derivatives, so the target's outline blends with
+  // the background as a camera's pixel area would. The mask keeps the
+  // centre ray's answer.
+  constexpr int kSubSamples = 4;
+  constexpr float kOffsets[kSubSamples][2] = {{-0.25f, -0.25f}, {0.25f, -0.25f}, {-0.25f, 0.25f}, {0.25f, 0.25f}};
+  for (int v = std::max(mv0 - 1, 0); v <= std::min(mv1 + 1, rays.height - 1); ++v) {
+    for (int u = std::max(mu0 - 1, 0); u <= std::min(mu1 + 1, rays.width - 1); ++u) {
+      const uint8_t m = view.mask.at<uint8_t>(v, u);
+      const int u0 = std::max(u - 1, 0), u1 = std::min(u + 1, rays.width - 1);
+      const int v0 = std::max(v - 1, 0), v1 = std::min(v + 1, rays.height - 1);
+      if (view.mask.at<uint8_t>(v, u0) == m && view.mask.at<uint8_t>(v, u1) == m &&
+          view.mask.at<uint8_t>(v0, u) == m && view.mask.at<uint8_t>(v1, u) == m) {
+        continue;
+      }
+      auto at = [&](const std::vector<float>& a, int uu, int vv) {
+        return a[static_cast<std::size_t>(vv) * width + static_cast<std::size_t>(uu)];
+      };
+      const float du = 1.0f / static_cast<float>(u1 - u0), dv = 1.0f / static_cast<float>(v1 - v0);
+      const float x_u = (at(rays.x, u1, v) - at(rays.x, u0, v)) * du, x_v = (at(rays.x, u, v1) - at(rays.x, u, v0)) * dv;
+      const float y_u = (at(rays.y, u1, v) - at(rays.y, u0, v)) * du, y_v = (at(rays.y, u, v1) - at(rays.y, u, v0)) * dv;
+      float sx[kSubSamples], sy[kSubSamples], sn[kSubSamples], sa[kSubSamples];
+      for (int k = 0; k < kSubSamples; ++k) {
+        sx[k] = at(rays.x, u, v) + kOffsets[k][0] * x_u + kOffsets[k][1] * x_v;
+        sy[k] = at(rays.y, u, v) + kOffsets[k][0] * y_u + kOffsets[k][1] * y_v;
+        sn[k] = 1.0f / std::sqrt(sx[k] * sx[k] + sy[k] * sy[k] + 1.0f);
+        sa[k] = at(rays.angle_norm, u, v);
+      }
+      float ss[kSubSamples], st[kSubSamples], slod[kSubSamples], st_room[kSubSamples];
+      int sface[kSubSamples];
+      room_row(room, kSubSamples, sx, sy, sn, sa, ss, st, slod, st_room, sface);
+      float sum = 0.0f;
+      for (int k = 0; k < kSubSamples; ++k) {
+        float value = 0.0f;
+        if (!(in_target_box(sx[k], sy[k]) && shade_target(sx[k], sy[k], sn[k], sa[k], st_room[k], &value))) {
+          value = shade_room(sface[k], ss[k], st[k], slod[k]);
+        }
+        sum += value;
+      }
+      radiance.at<float>(v, u) = sum / kSubSamples;
+    }
+  }
+
+  // Exposure gain, then noise; rounded and saturated to 8 bits.
   if (config_.noise_sigma > 0.0) {
     cv::RNG rng(derive_seed(noise_seed_ ^ static_cast<uint64_t>(utime), static_cast<uint64_t>(cam)));
     cv::Mat noise(radiance.size(), CV_32FC1);
     rng.fill(noise, cv::RNG::NORMAL, 0.0, config_.noise_sigma);
-    radiance += noise;
+    cv::scaleAdd(radiance, gain, noise, radiance);
+    radiance.convertTo(view.image, CV_8U);
+  } else {
+    radiance.convertTo(view.image, CV_8U, gain);
   }
-  radiance.convertTo(view.image, CV_8U);  // rounds and saturates
   view.visible = mu1 >= 0;
   if (view.visible) view.box = Eigen::Vector4d(mu0, mv0, mu1 - mu0 + 1, mv1 - mv0 + 1);
   return view;

@@ -20,8 +20,8 @@
 // footprint on the surface (distance · pixel angle / sqrt(cos incidence)),
 // so far surfaces are filtered rather than aliased. Then the exposure gain
 // and white noise (render.noise_sigma) are applied and the value rounded to
-// 8 bits. There is no edge anti-aliasing: a pixel shows the surface its
-// centre ray hits.
+// 8 bits. Pixels on the target's outline average 4 rays (anti-aliasing);
+// elsewhere a pixel shows the surface its centre ray hits.
 //
 // Truth: mask(u, v) = 255 where the target is the nearest surface along the
 // pixel's centre ray, else 0; box = [x_min, y_min, width, height] of the
