@@ -9,10 +9,10 @@
 #include <variant>
 
 #include "common/config/config.h"
-#include "common/eval/vins_config.h"
+#include "common/estimator/vins_config.h"
 #include "common/sim/simulator.h"
-#include "tests/procs/paper_events.h"
 #include "procs/vins/vins_node.h"
+#include "tests/procs/paper_events.h"
 
 using namespace vimot;
 
@@ -21,17 +21,17 @@ namespace {
 struct Outputs {
   std::vector<NavState> updated;
   std::vector<NavState> propagated;
-  std::vector<VinsEvent> events;
+  std::vector<NodeEvent> events;
 };
 
 Outputs run_node(const std::vector<sim::SimEvent>& events) {
   VinsNodeOptions options;
-  options.vio = eval::load_vio_options(source_path("config/vins.yaml"));
+  options.vio = estimator::load_vio_options(source_path("config/vins.yaml"));
   Outputs out;
   VinsNode node(
       options,
       [&](const NavState& s) { (s.updated ? out.updated : out.propagated).push_back(s); },
-      [&](const VinsEvent& e) { out.events.push_back(e); });
+      [&](const NodeEvent& e) { out.events.push_back(e); });
   for (const auto& e : events) {
     if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
     if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
@@ -98,9 +98,9 @@ TEST_CASE("vins node drops duplicate, out-of-order and non-finite input without 
   const Outputs out = run_node(dirty);
   CHECK(same_states(clean.updated, out.updated));
   int dropped = 0;
-  for (const auto& e : out.events) dropped += e.kind == VinsEvent::Kind::kDropped;
+  for (const auto& e : out.events) dropped += e.kind == NodeEvent::Kind::kDropped;
   int clean_dropped = 0;
-  for (const auto& e : clean.events) clean_dropped += e.kind == VinsEvent::Kind::kDropped;
+  for (const auto& e : clean.events) clean_dropped += e.kind == NodeEvent::Kind::kDropped;
   CHECK(dropped > clean_dropped);
 }
 
