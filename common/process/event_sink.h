@@ -1,0 +1,86 @@
+#pragma once
+// Where a sensor driver (vimot-sim, vimot-euroc-player) sends its time-ordered
+// messages: live LCM paced by a real-time factor, or straight into an LCM log
+// file as fast as the CPU allows, with event time = message utime so the
+// same input gives the same bytes.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "common/process/process.h"
+
+namespace vimot {
+
+class EventSink {
+ public:
+  virtual ~EventSink() = default;
+  virtual void write(const std::string& channel, int64_t utime, const void* data, int size) = 0;
+};
+
+class LogFileSink : public EventSink {
+ public:
+  /// Throws std::runtime_error if `path` cannot be opened for writing.
+  explicit LogFileSink(const std::string& path);
+  void write(const std::string& channel, int64_t utime, const void* data, int size) override;
+
+ private:
+  lcm::LogFile log_;
+  int64_t eventnum_{0};
+};
+
+/// Publishes through the process's LCM handle; with speed > 0 a message of
+/// time `utime` leaves (utime - first_utime) / speed after the start (the
+/// wall clock decides when, never what); speed 0 = as fast as possible.
+/// Sends the process heartbeat at 1 Hz while writing.
+class LcmSink : public EventSink {
+ public:
+  LcmSink(Process& process, double speed, int64_t first_utime, double start_delay_s);
+  void write(const std::string& channel, int64_t utime, const void* data, int size) override;
+
+ private:
+  Process& process_;
+  double speed_;
+  int64_t first_utime_;
+  std::chrono::steady_clock::time_point wall_start_;
+  std::chrono::steady_clock::time_point next_heartbeat_;
+};
+
+/// Declares the output options every driver shares: --speed, --start-delay,
+/// --log, --linger.
+void add_sink_options(ArgParser& args);
+
+/// The sink those options ask for: the --log file if given, else LCM paced
+/// by --speed with `first_utime` leaving after --start-delay. Throws
+/// ArgError for a negative --speed.
+std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime);
+
+/// Logs "progress N% (t s)" each time another tenth of a run is played.
+class ProgressLog {
+ public:
+  explicit ProgressLog(double span_s) : span_s_(span_s) {}
+  void update(double played_s);
+
+ private:
+  double span_s_;
+  int last_decile_{0};
+};
+
+/// Stays alive `seconds` after the last message (or until a stop signal), so
+/// consumers can drain their queues before the driver's exit ends a run.
+void linger(const Process& process, double seconds);
+
+/// Encodes an LCM message and writes it at its own utime.
+template <typename Msg>
+void emit(EventSink& sink, const std::string& channel, const Msg& msg) {
+  std::vector<uint8_t> buffer(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+  sink.write(channel, msg.utime, buffer.data(), static_cast<int>(buffer.size()));
+}
+
+}  // namespace vimot
