@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "common/config/config.h"
+#include "common/estimator/vins_config.h"
 #include "common/eval/machine.h"
 #include "common/eval/sim_runner.h"
-#include "common/eval/vins_config.h"
 #include "common/process/arg_parser.h"
 #include "common/sim/sim_config.h"
 
@@ -72,7 +72,7 @@ int run(int argc, const char* const* argv) {
   base.camera.max_depth = 7.0;
   base.camera.spawn_depth_min = 5.0;
   base.camera.spawn_depth_max = 7.0;
-  const estimator::VioOptions options = eval::load_vio_options(args.get("vins-config"));
+  const estimator::VioOptions options = estimator::load_vio_options(args.get("vins-config"));
   const int features = static_cast<int>(args.get_int("features"));
   const std::string which = args.get("sweep");
   if (which != "all" && which != "features" && which != "clones" && which != "slam") {

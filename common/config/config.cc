@@ -1,7 +1,10 @@
 #include "common/config/config.h"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 namespace vimot {
@@ -24,6 +27,51 @@ std::string strip_asl_header(const std::string& text) {
   return eol == std::string::npos ? std::string() : "\n" + text.substr(eol + 1);
 }
 
+// Flow style for `n` and everything in it (a parsed node keeps its own).
+void set_flow_style(YAML::Node n) {
+  if (!n.IsMap() && !n.IsSequence()) return;
+  n.SetStyle(YAML::EmitterStyle::Flow);
+  for (auto it = n.begin(); it != n.end(); ++it) set_flow_style(n.IsMap() ? it->second : *it);
+}
+
+// The value of a node for an error message: a scalar as written, anything
+// else on one line in YAML flow style, cut short.
+std::string describe(const YAML::Node& n) {
+  std::string text;
+  if (n.IsScalar()) {
+    text = n.Scalar();
+  } else {
+    const YAML::Node copy = YAML::Clone(n);
+    set_flow_style(copy);
+    YAML::Emitter out;
+    out << copy;
+    text = out.c_str();
+  }
+  constexpr std::size_t kMax = 60;
+  return text.size() > kMax ? text.substr(0, kMax) + "..." : text;
+}
+
+// yaml-cpp keeps every entry of a map, so a repeated key would be read as
+// its first value and the second silently ignored.
+void reject_duplicate_keys(const YAML::Node& node, const std::string& prefix, const std::string& source) {
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) reject_duplicate_keys(node[i], prefix, source);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    const std::string key = kv.first.Scalar();
+    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    if (!seen.insert(key).second) {
+      throw ConfigError("config '" + source + "': key '" + path + "' is repeated (line " +
+                        std::to_string(kv.first.Mark().line + 1) + ", value '" + describe(kv.second) +
+                        "'); each key may appear once");
+    }
+    reject_duplicate_keys(kv.second, path, source);
+  }
+}
+
 }  // namespace
 
 Config::Config() : root_(YAML::NodeType::Map), source_("<empty>") {}
@@ -32,11 +80,19 @@ Config::Config(YAML::Node root, std::string source, std::string prefix)
     : root_(std::move(root)), source_(std::move(source)), prefix_(std::move(prefix)) {}
 
 Config Config::load_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ConfigError("config '" + path + "': is a directory, not a YAML file");
+  }
   std::ifstream in(path);
   if (!in) throw ConfigError("config '" + path + "': cannot open file");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return from_string(buffer.str(), path);
+  Config config = from_string(buffer.str(), path);
+  // An empty file would fail later on its first required key, which hides
+  // the cause (e.g. "cameras.cam0: missing").
+  if (config.root_.size() == 0) throw ConfigError("config '" + path + "': is empty (no keys)");
+  return config;
 }
 
 Config Config::from_string(const std::string& text, const std::string& source) {
@@ -50,6 +106,7 @@ Config Config::from_string(const std::string& text, const std::string& source) {
   }
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw ConfigError("config '" + source + "': top level must be a map of keys");
+  reject_duplicate_keys(root, "", source);
   return Config(root, source, "");
 }
 
@@ -175,6 +232,20 @@ std::vector<std::string> Config::keys() const {
   if (!root_.IsMap()) return out;
   for (const auto& kv : root_) out.push_back(kv.first.as<std::string>());
   return out;
+}
+
+void Config::check_keys(const std::string& section, const std::vector<std::string>& known) const {
+  if (!section.empty() && !has(section)) return;
+  const YAML::Node node = section.empty() ? root_ : find(section);
+  if (!node.IsMap()) fail(section, "must be a map of keys");
+  const std::string prefix = section.empty() ? "" : section + ".";
+  for (const auto& kv : node) {
+    const std::string key = kv.first.Scalar();
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string list;
+    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+    fail(prefix + key, "(value '" + describe(kv.second) + "') is unknown (known keys: " + list + ")");
+  }
 }
 
 }  // namespace vimot

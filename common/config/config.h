@@ -2,9 +2,11 @@
 // YAML configuration with errors that name the file and the full key.
 //
 // Keys are dotted paths ("imu.gyroscope_noise_density"). Every getter checks
-// presence, type and finiteness, so a process refuses a bad config at start
-// instead of running on a silent default. Files in the ASL/EuRoC style (first
-// line "%YAML:1.0", which yaml-cpp rejects) are accepted.
+// presence, type and finiteness, and every options reader rejects keys it
+// does not know (check_keys), so a process refuses a bad config at start
+// instead of running on a silent default. A key repeated in one map is an
+// error at load. Files in the ASL/EuRoC style (first line "%YAML:1.0", which
+// yaml-cpp rejects) are accepted.
 
 #include <Eigen/Core>
 #include <stdexcept>
@@ -26,7 +28,8 @@ class Config {
   /// An empty configuration (every get() fails, every get_or() defaults).
   Config();
 
-  /// Loads a YAML file; throws ConfigError if missing or malformed.
+  /// Loads a YAML file; throws ConfigError if missing, a directory, empty
+  /// (nothing but comments), malformed or with a key repeated in one map.
   static Config load_file(const std::string& path);
 
   /// Parses YAML text; `source` names it in error messages.
@@ -62,6 +65,13 @@ class Config {
 
   /// Top-level keys of a map node (empty for anything else).
   std::vector<std::string> keys() const;
+
+  /// The one unknown-key check of every options reader: each key of the map
+  /// at `section` ("" = this config's top level; an absent section passes)
+  /// must be in `known`, else ConfigError naming the file, the full key
+  /// path, its value and the known keys (a misspelt option must not keep
+  /// its default silently).
+  void check_keys(const std::string& section, const std::vector<std::string>& known) const;
 
   const std::string& source() const { return source_; }
 

@@ -102,6 +102,18 @@ VioOptions VioOptions::from_config(const Config& estimator_cfg, const Config& ca
   VioOptions o;
   const std::string s = section.empty() ? "" : section + ".";
   const Config& c = estimator_cfg;
+  if (!section.empty()) {
+    c.check_keys(section, {"num_clones", "max_slam", "use_fej", "slam_representation", "max_slam_init_per_frame",
+                           "slam_max_chi2_failures", "max_msckf_in_update", "msckf_chi2_multiplier",
+                           "slam_chi2_multiplier", "use_stereo", "sigma_px", "gravity_magnitude", "max_imu_gap_s",
+                           "imu_buffer_s", "triangulation", "init", "divergence", "imu_noise"});
+  }
+  c.check_keys(s + "triangulation", {"min_depth", "max_depth", "max_condition", "max_iterations"});
+  c.check_keys(s + "init", {"mode", "window_s", "max_accel_std", "sigma_theta_rp", "sigma_yaw", "sigma_p", "sigma_v",
+                            "sigma_bg", "sigma_ba"});
+  c.check_keys(s + "divergence", {"max_position_correction_m", "max_velocity_mps"});
+  c.check_keys(s + "imu_noise", {"gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
+                                 "accelerometer_random_walk"});
   read(c, s + "num_clones", &o.state.max_clones);
   read(c, s + "max_slam", &o.state.max_slam);
   read(c, s + "use_fej", &o.state.use_fej);

@@ -8,8 +8,8 @@
 #include <thread>
 #include <variant>
 
-#include "common/eval/initial_estimate.h"
-#include "common/eval/nav_state_of.h"
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/nav_state_of.h"
 #include "common/sim/simulator.h"
 
 namespace vimot {
@@ -47,7 +47,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
   r.duration_s = sim.duration();
   r.camera_frames = sim.camera_frame_count();
 
-  const InitialEstimate x0 = initial_estimate(sim.initial_state(), options, perturb_seed);
+  const estimator::InitialEstimate x0 = estimator::initial_estimate(sim.initial_state(), options, perturb_seed);
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
 
   TrajectoryErrors errors;
@@ -94,7 +94,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
       ++r.frames_without_truth;
       return true;
     }
-    const NavState x = nav_state_of(est, true);
+    const NavState x = estimator::nav_state_of(est, true);
     FrameSample s;
     s.utime = x.utime;
     s.q_GtoI = x.q_GtoI;
@@ -145,7 +145,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
 
 uint64_t perturb_seed_of(const MonteCarloOptions& o, uint64_t sim_seed) {
   if (!o.perturb) return 0;
-  return o.fixed_perturb_seed != 0 ? o.fixed_perturb_seed : perturb_seed_for_run(sim_seed);
+  return o.fixed_perturb_seed != 0 ? o.fixed_perturb_seed : estimator::perturb_seed_for_run(sim_seed);
 }
 
 void run_parallel(int jobs, int threads_wanted, const std::function<void(int, const std::function<void(double)>&)>& job,

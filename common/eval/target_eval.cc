@@ -5,19 +5,19 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <variant>
 
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/nav_state_of.h"
 #include "common/estimator/state_helper.h"
-#include "common/eval/initial_estimate.h"
 #include "common/eval/json.h"
-#include "common/eval/nav_state_of.h"
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/sim/simulator.h"
 #include "common/target/target_conversion.h"
+#include "common/target/target_filter_config.h"
 
 namespace vimot {
 namespace eval {
@@ -29,85 +29,10 @@ using target::TargetFilterOptions;
 using target::TargetRepresentation;
 using target::TargetUpdateMode;
 
-target::TargetUpdateMode parse_target_mode(const std::string& s) {
-  if (s == "ekf") return TargetUpdateMode::kEkf;
-  if (s == "skf") return TargetUpdateMode::kSkf;
-  if (s == "off") return TargetUpdateMode::kOff;
-  throw std::invalid_argument("target mode must be ekf|skf|off, got '" + s + "'");
-}
-
-target::TargetRepresentation parse_target_representation(const std::string& s) {
-  if (s == "global") return TargetRepresentation::kGlobal;
-  if (s == "local") return TargetRepresentation::kLocal;
-  throw std::invalid_argument("target representation must be global|local, got '" + s + "'");
-}
-
-namespace {
-
-void check_keys(const Config& c, const std::set<std::string>& allowed) {
-  for (const std::string& k : c.keys()) {
-    if (!allowed.count(k)) c.fail(k, "is not a known key");
-  }
-}
-
-double positive(const Config& c, const std::string& key, double fallback) {
-  const double v = c.get_or<double>(key, fallback);
-  if (!(v > 0.0)) c.fail(key, "must be > 0, got " + std::to_string(v));
-  return v;
-}
-
-int at_least(const Config& c, const std::string& key, int fallback, int min) {
-  const int v = c.get_or<int>(key, fallback);
-  if (v < min) c.fail(key, "must be >= " + std::to_string(min) + ", got " + std::to_string(v));
-  return v;
-}
-
-}  // namespace
-
 target::TargetFilterOptions target_filter_options(const Config& config) {
-  TargetFilterOptions o;
-  if (!config.has("target")) return o;
-  const Config c = config.sub("target");
-  check_keys(c, {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times", "init_sigmas",
-                 "points", "prediction_horizon_s" /* the vimot-target-filter process's, ignored here */});
-  if (c.has("mode")) {
-    try {
-      o.mode = parse_target_mode(c.get<std::string>("mode"));
-    } catch (const std::invalid_argument& e) {
-      c.fail("mode", e.what());
-    }
-  }
-  if (c.has("representation")) {
-    try {
-      o.representation = parse_target_representation(c.get<std::string>("representation"));
-    } catch (const std::invalid_argument& e) {
-      c.fail("representation", e.what());
-    }
-  }
-  o.sigma_t = positive(c, "sigma_t", o.sigma_t);
-  o.planar = c.get_or<bool>("planar", o.planar);
-  o.chi2_multiplier = positive(c, "chi2_multiplier", o.chi2_multiplier);
-  o.min_clone_times = at_least(c, "min_clone_times", o.min_clone_times, 2);
-  if (c.has("init_sigmas")) {
-    const Config s = c.sub("init_sigmas");
-    check_keys(s, {"theta", "p", "v", "w"});
-    o.init_sigmas.theta = positive(s, "theta", o.init_sigmas.theta);
-    o.init_sigmas.p = positive(s, "p", o.init_sigmas.p);
-    o.init_sigmas.v = positive(s, "v", o.init_sigmas.v);
-    o.init_sigmas.w = positive(s, "w", o.init_sigmas.w);
-  }
-  if (c.has("points")) {
-    const Config p = c.sub("points");
-    check_keys(p, {"max", "init_clone_times", "max_lost_frames"});
-    o.max_target_points = at_least(p, "max", o.max_target_points, 0);
-    o.point_init_clone_times = at_least(p, "init_clone_times", o.point_init_clone_times, 2);
-    o.point_max_lost_frames = at_least(p, "max_lost_frames", o.point_max_lost_frames, 1);
-  }
-  return o;
-}
-
-target::TargetFilterOptions load_target_filter_options(const std::string& path) {
-  return target_filter_options(Config::load_file(path));
+  const target::TargetSection t = target::target_section_from_config(config);
+  if (!t.enabled) config.fail("target.mode", "none attaches no filter: not a target-filter evaluation");
+  return t.filter;
 }
 
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
@@ -124,7 +49,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   r.perturb_seed = perturb_seed;
   const int64_t frames_total = std::max<int64_t>(1, sim.camera_frame_count());
 
-  const InitialEstimate x0 = initial_estimate(sim.initial_state(), options, perturb_seed);
+  const estimator::InitialEstimate x0 = estimator::initial_estimate(sim.initial_state(), options, perturb_seed);
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
   std::unique_ptr<target::TargetFilter> filter;
   if (filter_options) {
@@ -156,7 +81,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     if (st != FrameStatus::kProcessed) return true;
     if (!have_truth || truth.utime != frame.utime || !target_seen) return true;
     try {
-      e_imu.add(error_of(nav_state_of(est, true), truth));
+      e_imu.add(error_of(estimator::nav_state_of(est, true), truth));
       if (filter && filter->initialized() && truth.has_target) {
         r.target_initialized = true;
         const estimator::State& s = est.state();
@@ -266,7 +191,7 @@ std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estim
         std::optional<TargetFilterOptions> f;
         if (!c.vio_only) f = c.filter;
         c.runs[static_cast<std::size_t>(i)] =
-            run_target_on_sim(cfg, options, f, o.fixed_perturb_seed.value_or(perturb_seed_for_run(seed)), fr,
+            run_target_on_sim(cfg, options, f, o.fixed_perturb_seed.value_or(estimator::perturb_seed_for_run(seed)), fr,
                               o.keep_samples);
       },
       progress);
@@ -456,8 +381,8 @@ std::vector<TargetCell> read_target_cells(const std::string& summary_json) {
       TargetCell cell;
       cell.vio_only = c.at("mode").string() == "vio";
       if (!cell.vio_only) {
-        cell.filter.mode = parse_target_mode(c.at("mode").string());
-        cell.filter.representation = parse_target_representation(c.at("representation").string());
+        cell.filter.mode = target::parse_target_mode(c.at("mode").string());
+        cell.filter.representation = target::parse_target_representation(c.at("representation").string());
         cell.filter.sigma_t = c.at("sigma_t").number();
       }
       const JsonValue& runs = c.at("per_run");

@@ -37,17 +37,10 @@
 namespace vimot {
 namespace eval {
 
-/// TargetFilterOptions from the `target:` section of `config` (keys mode:
-/// ekf|skf|off, representation: global|local, sigma_t, planar,
-/// chi2_multiplier, min_clone_times, init_sigmas.{theta,p,v,w},
-/// points.{max, init_clone_times, max_lost_frames}; prediction_horizon_s, the
-/// process's, is accepted and ignored); every key optional
-/// (TargetFilterOptions' default). Throws ConfigError naming the key.
+/// TargetFilterOptions from the `target:` section of a target_filter config
+/// (common/target/target_filter_config.h; mode none is refused: the sweep
+/// runs its VIO-only cells itself). Throws ConfigError naming the key.
 target::TargetFilterOptions target_filter_options(const Config& config);
-target::TargetFilterOptions load_target_filter_options(const std::string& path);
-
-target::TargetUpdateMode parse_target_mode(const std::string& s);                  // ekf|skf|off
-target::TargetRepresentation parse_target_representation(const std::string& s);  // global|local
 
 struct TargetRunResult {
   uint64_t sim_seed{0};

@@ -4,17 +4,17 @@
 // get wrong (non-finite numbers, bad counts, camera ids) and throws
 // std::invalid_argument saying what; the scaffold counts it as an error.
 
+#include "common/object/scale_estimator.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
 #include "common/types/object_pose.h"
 #include "common/types/sensor_data.h"
 #include "common/types/target_state.h"
-#include "procs/scale_estimator/scale_estimator.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
 #include "vimot/imu_t.hpp"
-#include "vimot/nav_state_t.hpp"
 #include "vimot/metric_object_pose_t.hpp"
+#include "vimot/nav_state_t.hpp"
 #include "vimot/object_pose_t.hpp"
 #include "vimot/scale_estimate_t.hpp"
 #include "vimot/target_prediction_t.hpp"

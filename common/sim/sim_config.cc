@@ -167,16 +167,8 @@ class Reader {
   }
 
   // Rejects keys of the map at `section` ("" = top level) not in `allowed`.
-  void only_keys(const std::string& section, const std::set<std::string>& allowed) const {
-    if (!section.empty() && !root_.has(section)) return;
-    const Config node = section.empty() ? root_ : root_.sub(section);
-    for (const std::string& k : node.keys()) {
-      if (allowed.count(k) == 0) {
-        std::string list;
-        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(section.empty() ? k : section + "." + k, "is unknown (expected one of: " + list + ")");
-      }
-    }
+  void only_keys(const std::string& section, const std::vector<std::string>& allowed) const {
+    root_.check_keys(section, allowed);
   }
 
   template <typename T>

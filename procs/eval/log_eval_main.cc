@@ -8,10 +8,10 @@
 #include <iostream>
 
 #include "common/eval/json.h"
+#include "common/eval/log_eval.h"
 #include "common/eval/writers.h"
 #include "common/process/arg_parser.h"
 #include "common/process/process.h"
-#include "procs/eval/log_eval.h"
 
 namespace {
 

@@ -16,17 +16,17 @@
 #include <thread>
 
 #include "common/config/config.h"
-#include "common/eval/initial_estimate.h"
+#include "common/estimator/initial_estimate.h"
+#include "common/eval/evaluation_setup.h"
 #include "common/eval/json.h"
 #include "common/eval/machine.h"
 #include "common/eval/progress.h"
 #include "common/eval/sim_runner.h"
-#include "common/eval/vins_config.h"
 #include "common/eval/writers.h"
 #include "common/process/arg_parser.h"
 #include "common/process/logger.h"
 #include "procs/eval/monte_carlo_args.h"
-#include "procs/eval/scale_eval.h"
+#include "procs/eval/scale_run.h"
 
 namespace {
 
@@ -109,7 +109,7 @@ int run(int argc, const char* const* argv) {
         sim::SimConfig cfg = setup.sim;
         cfg.seed = static_cast<uint64_t>(first + i);
         results[static_cast<std::size_t>(i)] =
-            eval::run_scale_on_sim(cfg, options, fixed_perturb.value_or(eval::perturb_seed_for_run(cfg.seed)), fr);
+            eval::run_scale_on_sim(cfg, options, fixed_perturb.value_or(estimator::perturb_seed_for_run(cfg.seed)), fr);
       },
       [&bar](const eval::MonteCarloProgress& p) { bar.update(p); });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -14,14 +14,15 @@
 #include <thread>
 
 #include "common/config/config.h"
+#include "common/eval/evaluation_setup.h"
 #include "common/eval/machine.h"
 #include "common/eval/progress.h"
 #include "common/eval/target_eval.h"
-#include "common/eval/vins_config.h"
 #include "common/eval/writers.h"
 #include "common/process/arg_parser.h"
 #include "common/process/logger.h"
 #include "common/sim/simulator.h"
+#include "common/target/target_filter_config.h"
 #include "procs/eval/monte_carlo_args.h"
 
 namespace {
@@ -111,7 +112,7 @@ int run(int argc, const char* const* argv) {
   for (const std::string& m : setup.model_mismatches) log_warn("estimator model differs from the simulator: ", m);
   const sim::SimConfig& sim_cfg = setup.sim;
   const estimator::VioOptions& options = setup.vio;
-  const target::TargetFilterOptions base_filter = eval::load_target_filter_options(target_path);
+  const target::TargetFilterOptions base_filter = eval::target_filter_options(Config::load_file(target_path));
 
   eval::TargetSweepOptions o;
   o.sigmas.clear();
@@ -130,12 +131,12 @@ int run(int argc, const char* const* argv) {
   o.modes.clear();
   for (const std::string& s : split(args.get("modes"))) {
     if (s != "ekf" && s != "skf") throw ArgError("--modes: expected ekf and/or skf, got '" + s + "'");
-    o.modes.push_back(eval::parse_target_mode(s));
+    o.modes.push_back(target::parse_target_mode(s));
   }
   o.representations.clear();
   for (const std::string& s : split(args.get("representations"))) {
     try {
-      o.representations.push_back(eval::parse_target_representation(s));
+      o.representations.push_back(target::parse_target_representation(s));
     } catch (const std::invalid_argument& e) {
       throw ArgError(std::string("--representations: ") + e.what());
     }

@@ -12,11 +12,11 @@
 #include <thread>
 
 #include "common/config/config.h"
+#include "common/eval/evaluation_setup.h"
 #include "common/eval/machine.h"
 #include "common/eval/progress.h"
 #include "common/eval/report.h"
 #include "common/eval/sim_runner.h"
-#include "common/eval/vins_config.h"
 #include "common/eval/writers.h"
 #include "common/process/arg_parser.h"
 #include "common/process/logger.h"

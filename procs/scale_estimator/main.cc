@@ -6,9 +6,9 @@
 // All logic is in ScaleNode / the scale estimator library; this file moves bytes.
 
 #include "common/process/lcm_conversions.h"
+#include "common/process/node_runner.h"
 #include "common/process/process.h"
 #include "procs/scale_estimator/scale_node.h"
-#include "procs/vins/node_runner.h"
 
 namespace {
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 #include <stdexcept>
 
 #include "common/config/config.h"
@@ -38,15 +37,11 @@ void ScaleNodeOptions::validate_object_filter() const {
 
 void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* options) {
   if (!cfg.has("object_filter")) return;
-  static const std::set<std::string> kKeys = {
-      "sigma_v",      "sigma_w",      "k_lateral",       "k_depth",
-      "sigma_theta",  "bias_sigma_theta", "bias_sigma_position", "scale_sigma", "scale_random_walk",
-      "init_sigma_v", "init_sigma_w",    "chi2_multiplier",
-      "max_consecutive_rejections",   "max_gap_s",       "prediction_horizon_s"};
+  cfg.check_keys("object_filter", {"sigma_v", "sigma_w", "k_lateral", "k_depth", "sigma_theta", "bias_sigma_theta",
+                                   "bias_sigma_position", "scale_sigma", "scale_random_walk", "init_sigma_v",
+                                   "init_sigma_w", "chi2_multiplier", "max_consecutive_rejections", "max_gap_s",
+                                   "prediction_horizon_s"});
   const Config sec = cfg.sub("object_filter");
-  for (const std::string& k : sec.keys()) {
-    if (!kKeys.count(k)) sec.fail(k, "is not an object_filter option");
-  }
   target::ObjectPoseFilterOptions& f = options->filter;
   if (sec.has("sigma_v")) f.noise.sigma_v = Eigen::Vector3d::Constant(sec.get<double>("sigma_v"));
   if (sec.has("sigma_w")) f.noise.sigma_w = Eigen::Vector3d::Constant(sec.get<double>("sigma_w"));
@@ -71,6 +66,8 @@ void object_filter_options_from_config(const Config& cfg, ScaleNodeOptions* opti
 }
 
 ScaleNodeOptions scale_node_options_from_config(const Config& cfg) {
+  cfg.check_keys("", {"calibration_file", "channels", "node", "object_filter", "scale_estimator"});
+  cfg.check_keys("node", {"max_pending", "estimate_period_s"});
   ScaleNodeOptions o;
   o.estimator = scale::ScaleEstimatorOptions::from_config(cfg, "scale_estimator");
   const Config calib = Config::load_file(cfg.resolve_path(cfg.get<std::string>("calibration_file")));
@@ -96,14 +93,14 @@ ScaleNode::ScaleNode(const ScaleNodeOptions& options, ScaleCallback on_scale, Po
       on_object_state_(std::move(on_object_state)),
       filter_(options.filter) {}
 
-void ScaleNode::say(VinsEvent::Kind kind, const std::string& message) {
-  if (on_event_) on_event_(VinsEvent{kind, message});
+void ScaleNode::say(NodeEvent::Kind kind, const std::string& message) {
+  if (on_event_) on_event_(NodeEvent{kind, message});
 }
 
 bool ScaleNode::in_order(int64_t utime, std::optional<int64_t>* last, const char* channel) {
   if (*last && utime <= **last) {
     ++stats_.duplicate_or_backwards;
-    say(VinsEvent::Kind::kDropped, std::string(channel) + (utime == **last ? " duplicate" : " went back in time") +
+    say(NodeEvent::Kind::kDropped, std::string(channel) + (utime == **last ? " duplicate" : " went back in time") +
                                        " at utime " + std::to_string(utime));
     return false;
   }
@@ -115,7 +112,7 @@ template <typename T>
 void ScaleNode::drop_older(std::deque<T>* queue, int64_t utime, int64_t* counter, const char* what) {
   while (!queue->empty() && queue->front().utime < utime) {
     ++*counter;
-    say(VinsEvent::Kind::kDropped, std::string(what) + " at utime " + std::to_string(queue->front().utime) +
+    say(NodeEvent::Kind::kDropped, std::string(what) + " at utime " + std::to_string(queue->front().utime) +
                                        " never matched");
     queue->pop_front();
   }
@@ -134,7 +131,7 @@ void ScaleNode::on_nav_state(const NavState& state) {
   }
   if (last_object_utime_ && *last_object_utime_ > state.utime) {
     ++stats_.stale_states;  // the tracker is past this frame: it skipped it
-    say(VinsEvent::Kind::kDropped, "VINS state at utime " + std::to_string(state.utime) + " never matched");
+    say(NodeEvent::Kind::kDropped, "VINS state at utime " + std::to_string(state.utime) + " never matched");
     return;
   }
   states_.push_back(state);
@@ -152,7 +149,7 @@ void ScaleNode::on_object_pose(const ObjectPoseEstimate& pose) {
     ++stats_.invalid_object_poses;
     if (state_waiting) states_.pop_front();
     if (!estimator_.window().empty()) {
-      say(VinsEvent::Kind::kInfo, "object tracking lost at utime " + std::to_string(pose.utime) + ": window cleared");
+      say(NodeEvent::Kind::kInfo, "object tracking lost at utime " + std::to_string(pose.utime) + ": window cleared");
     }
     estimator_.clear_window();
     last_estimate_utime_.reset();
@@ -160,7 +157,7 @@ void ScaleNode::on_object_pose(const ObjectPoseEstimate& pose) {
   }
   if (track_id_ && *track_id_ != pose.track_id) {
     ++stats_.new_tracks;
-    say(VinsEvent::Kind::kInfo, "new object track " + std::to_string(pose.track_id) + " at utime " +
+    say(NodeEvent::Kind::kInfo, "new object track " + std::to_string(pose.track_id) + " at utime " +
                                     std::to_string(pose.utime) + ": scale estimator and object filter reset");
     estimator_.reset();
     filter_.reset();
@@ -175,7 +172,7 @@ void ScaleNode::on_object_pose(const ObjectPoseEstimate& pose) {
   }
   if (last_state_utime_ && *last_state_utime_ > pose.utime) {
     ++stats_.stale_object_poses;  // VINS is past this frame: it skipped it
-    say(VinsEvent::Kind::kDropped, "object pose at utime " + std::to_string(pose.utime) + " never matched");
+    say(NodeEvent::Kind::kDropped, "object pose at utime " + std::to_string(pose.utime) + " never matched");
     return;
   }
   object_poses_.push_back(pose);
@@ -197,12 +194,12 @@ void ScaleNode::process_pair(const NavState& state, const ObjectPoseEstimate& po
   const scale::AddStatus status = estimator_.add(obs);
   if (!scale::is_added(status)) {
     ++stats_.rejected_observations;
-    say(VinsEvent::Kind::kDropped, std::string("pair at utime ") + std::to_string(obs.utime) +
+    say(NodeEvent::Kind::kDropped, std::string("pair at utime ") + std::to_string(obs.utime) +
                                        " rejected: " + scale::to_string(status));
     return;
   }
   if (status == scale::AddStatus::kAddedAfterGap) {
-    say(VinsEvent::Kind::kInfo, "gap before utime " + std::to_string(obs.utime) + ": window cleared");
+    say(NodeEvent::Kind::kInfo, "gap before utime " + std::to_string(obs.utime) + ": window cleared");
     last_estimate_utime_.reset();
   }
 
@@ -232,12 +229,12 @@ void ScaleNode::filter_pose(const NavState& state, const CameraPoseInWorld& came
   z.scale = metric.scale;
   const target::ObjectFilterStatus status = filter_.add(z);
   if (!target::is_accepted(status)) {
-    say(VinsEvent::Kind::kDropped, "object filter at utime " + std::to_string(z.utime) + ": " +
+    say(NodeEvent::Kind::kDropped, "object filter at utime " + std::to_string(z.utime) + ": " +
                                        target::to_string(status));
     return;
   }
   if (status == target::ObjectFilterStatus::kReinitialized) {
-    say(VinsEvent::Kind::kInfo, "object filter re-initialised at utime " + std::to_string(z.utime));
+    say(NodeEvent::Kind::kInfo, "object filter re-initialised at utime " + std::to_string(z.utime));
   }
   ++stats_.object_states;
   if (!on_object_state_) return;

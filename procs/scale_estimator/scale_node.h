@@ -36,12 +36,12 @@
 #include <Eigen/Core>
 
 #include "common/camera/camera_model.h"
+#include "common/object/scale_estimator.h"
+#include "common/process/node_event.h"
 #include "common/target/object_pose_filter.h"
 #include "common/types/nav_state.h"
 #include "common/types/object_pose.h"
 #include "common/types/target_state.h"
-#include "procs/scale_estimator/scale_estimator.h"
-#include "procs/vins/vins_node.h"
 
 namespace vimot {
 
@@ -112,7 +112,7 @@ class ScaleNode {
   /// the paired VINS pose) and its prediction, per accepted metric pose.
   using ObjectStateCallback = std::function<void(const TargetStateEstimate&, const TargetPosePrediction&)>;
   /// The event kinds of the estimator processes (info, dropped, error).
-  using EventCallback = std::function<void(const VinsEvent&)>;
+  using EventCallback = std::function<void(const NodeEvent&)>;
 
   /// Throws std::invalid_argument on invalid options.
   ScaleNode(const ScaleNodeOptions& options, ScaleCallback on_scale, PoseCallback on_pose,
@@ -136,7 +136,7 @@ class ScaleNode {
   void drop_older(std::deque<T>* queue, int64_t utime, int64_t* counter, const char* what);
   void process_pair(const NavState& state, const ObjectPoseEstimate& pose);
   void filter_pose(const NavState& state, const CameraPoseInWorld& camera, const scale::ObjectPoseInWorld& metric);
-  void say(VinsEvent::Kind kind, const std::string& message);
+  void say(NodeEvent::Kind kind, const std::string& message);
 
   ScaleNodeOptions options_;
   scale::ScaleEstimator estimator_;

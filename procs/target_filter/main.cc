@@ -7,7 +7,7 @@
 
 #include "common/process/lcm_conversions.h"
 #include "common/process/process.h"
-#include "procs/vins/node_runner.h"
+#include "common/process/node_runner.h"
 #include "procs/target_filter/target_filter_node.h"
 
 namespace {

@@ -3,63 +3,37 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/nav_state_of.h"
 #include "common/estimator/state_helper.h"
-#include "common/eval/initial_estimate.h"
-#include "common/eval/nav_state_of.h"
-#include "common/eval/vins_config.h"
+#include "common/estimator/vins_config.h"
+#include "common/target/target_filter_config.h"
 #include "common/target/target_model.h"
 #include "common/target/target_output.h"
 
 namespace vimot {
 
-namespace {
-
-target::TargetUpdateMode parse_mode(const std::string& s) {
-  if (s == "skf") return target::TargetUpdateMode::kSkf;
-  if (s == "ekf") return target::TargetUpdateMode::kEkf;
-  if (s == "off") return target::TargetUpdateMode::kOff;
-  throw std::invalid_argument("target.mode must be skf, ekf, off or none, not '" + s + "'");
-}
-
-target::TargetRepresentation parse_representation(const std::string& s) {
-  if (s == "local") return target::TargetRepresentation::kLocal;
-  if (s == "global") return target::TargetRepresentation::kGlobal;
-  throw std::invalid_argument("target.representation must be local or global, not '" + s + "'");
-}
-
-}  // namespace
-
 void target_options_from_config(const Config& cfg, TargetFilterNodeOptions* options) {
-  target::TargetFilterOptions& t = options->target;
-  const std::string mode = cfg.get_or<std::string>("target.mode", "skf");
-  options->target_enabled = mode != "none";
-  if (options->target_enabled) t.mode = parse_mode(mode);
-  t.representation = parse_representation(cfg.get_or<std::string>(
-      "target.representation", t.representation == target::TargetRepresentation::kLocal ? "local" : "global"));
-  t.sigma_t = cfg.get_or<double>("target.sigma_t", t.sigma_t);
-  t.planar = cfg.get_or<bool>("target.planar", t.planar);
-  t.chi2_multiplier = cfg.get_or<double>("target.chi2_multiplier", t.chi2_multiplier);
-  t.min_clone_times = cfg.get_or<int>("target.min_clone_times", t.min_clone_times);
-  t.max_target_points = cfg.get_or<int>("target.points.max", t.max_target_points);
-  t.point_init_clone_times = cfg.get_or<int>("target.points.init_clone_times", t.point_init_clone_times);
-  t.point_max_lost_frames = cfg.get_or<int>("target.points.max_lost_frames", t.point_max_lost_frames);
-  t.init_sigmas.theta = cfg.get_or<double>("target.init_sigmas.theta", t.init_sigmas.theta);
-  t.init_sigmas.p = cfg.get_or<double>("target.init_sigmas.p", t.init_sigmas.p);
-  t.init_sigmas.v = cfg.get_or<double>("target.init_sigmas.v", t.init_sigmas.v);
-  t.init_sigmas.w = cfg.get_or<double>("target.init_sigmas.w", t.init_sigmas.w);
-  options->prediction_horizon_s = cfg.get_or<double>("target.prediction_horizon_s", options->prediction_horizon_s);
-  if (!(options->prediction_horizon_s >= 0.0) || !std::isfinite(options->prediction_horizon_s)) {
-    throw std::invalid_argument("target.prediction_horizon_s must be finite and >= 0");
-  }
+  const target::TargetSection t = target::target_section_from_config(cfg);
+  options->target = t.filter;
+  options->target_enabled = t.enabled;
+  options->prediction_horizon_s = t.prediction_horizon_s;
 }
 
 TargetFilterNodeOptions node_options_from_config(const Config& cfg) {
-  const Config vins = cfg.has("vins_config")
-                          ? Config::load_file(cfg.resolve_path(cfg.get<std::string>("vins_config")))
-                          : cfg;
+  // Without vins_config, the vins config's keys are in this file itself.
+  const bool separate_vins = cfg.has("vins_config");
+  const std::vector<std::string>& vins_keys = estimator::vins_config_keys();
+  std::vector<std::string> keys = {"vins_config", "channels", "output", "target"};
+  if (!separate_vins) keys.insert(keys.end(), vins_keys.begin(), vins_keys.end());
+  cfg.check_keys("", keys);
+  cfg.check_keys("output", {"imu_rate"});
+  const Config vins =
+      separate_vins ? Config::load_file(cfg.resolve_path(cfg.get<std::string>("vins_config"))) : cfg;
+  if (separate_vins) vins.check_keys("", vins_keys);
   TargetFilterNodeOptions options;
-  options.vio = eval::vio_options_from_config(vins);
-  const eval::VinsStartOptions start = eval::start_options_from_config(vins);
+  options.vio = estimator::vio_options_from_config(vins);
+  const estimator::VinsStartOptions start = estimator::start_options_from_config(vins);
   options.init_from_ground_truth = start.mode == estimator::InitMode::kGroundTruth;
   options.perturb_seed = start.perturb_seed;
   options.publish_imu_rate = cfg.get_or<bool>("output.imu_rate", options.publish_imu_rate);
@@ -109,7 +83,7 @@ TargetFilterNode::TargetFilterNode(const TargetFilterNodeOptions& options, Callb
           [this](const NavState& s) {
             if (callbacks_.on_nav_state) callbacks_.on_nav_state(s);
           },
-          [this](const VinsEvent& e) {
+          [this](const NodeEvent& e) {
             if (callbacks_.on_event) callbacks_.on_event(e);
           }) {
   if (options_.target_enabled) {

@@ -56,18 +56,15 @@ struct TargetFilterNodeOptions {
 ///     to this file) for the estimator and the start; without it those
 ///     sections are read from this file itself;
 ///   output.imu_rate;
-///   target: (keys of vimot-target-eval's file, absent keys keep
-///     TargetFilterOptions' defaults) mode skf | ekf | off | none (none: no
-///     filter attached), representation local | global, sigma_t, planar,
-///     chi2_multiplier, min_clone_times, init_sigmas.{theta,p,v,w},
-///     points.{max,init_clone_times,max_lost_frames}, prediction_horizon_s.
-/// Throws std::invalid_argument (or the Config's error) on a bad value.
+///   target: common/target/target_filter_config.h (mode none: no filter
+///     attached).
+/// Throws ConfigError naming the file and key on a bad value or unknown key.
 TargetFilterNodeOptions node_options_from_config(const Config& cfg);
 /// Only the `target:` section, into *options.
 void target_options_from_config(const Config& cfg, TargetFilterNodeOptions* options);
 
 /// Input and processing events, as the vins process reports them.
-using TargetFilterEvent = VinsEvent;
+using TargetFilterEvent = NodeEvent;
 
 class TargetFilterNode {
  public:

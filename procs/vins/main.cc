@@ -4,10 +4,9 @@
 // (updated = false) and camera-rate updated states (updated = true).
 // All logic is in VinsNode / the estimator library; this file moves bytes.
 
-#include "common/eval/vins_config.h"
 #include "common/process/lcm_conversions.h"
+#include "common/process/node_runner.h"
 #include "common/process/process.h"
-#include "procs/vins/node_runner.h"
 #include "procs/vins/vins_node.h"
 
 namespace {
@@ -24,15 +23,10 @@ int run(int argc, const char* const* argv) {
                             "process a queued camera frame after this much wall time without IMU", "0.5");
   if (!process.init(argc, argv)) return 0;
 
-  vimot::VinsNodeOptions options;
-  options.vio = vimot::eval::vio_options_from_config(process.config());
-  const vimot::eval::VinsStartOptions start = vimot::eval::start_options_from_config(process.config());
-  options.init_from_ground_truth = start.mode == vimot::estimator::InitMode::kGroundTruth;
-  options.perturb_seed = start.perturb_seed;
+  vimot::VinsNodeOptions options = vimot::vins_node_options_from_config(process.config());
   if (process.args().given("perturb-seed")) {
     options.perturb_seed = static_cast<uint64_t>(process.args().get_int("perturb-seed"));
   }
-  options.publish_imu_rate = process.config().get_or<bool>("output.imu_rate", true);
   const double max_wait = process.args().get_double("max-wait");
 
   const std::string state_channel = process.channel("state", "VINS_STATE");

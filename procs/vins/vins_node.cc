@@ -2,10 +2,23 @@
 
 #include <sstream>
 
-#include "common/eval/initial_estimate.h"
-#include "common/eval/nav_state_of.h"
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/nav_state_of.h"
+#include "common/estimator/vins_config.h"
 
 namespace vimot {
+
+VinsNodeOptions vins_node_options_from_config(const Config& cfg) {
+  cfg.check_keys("", estimator::vins_config_keys());
+  cfg.check_keys("output", {"imu_rate"});
+  VinsNodeOptions options;
+  options.vio = estimator::vio_options_from_config(cfg);
+  const estimator::VinsStartOptions start = estimator::start_options_from_config(cfg);
+  options.init_from_ground_truth = start.mode == estimator::InitMode::kGroundTruth;
+  options.perturb_seed = start.perturb_seed;
+  options.publish_imu_rate = cfg.get_or<bool>("output.imu_rate", options.publish_imu_rate);
+  return options;
+}
 
 VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, EventCallback on_event)
     : options_(options), estimator_(options.vio), on_state_(std::move(on_state)), on_event_(std::move(on_event)) {}
@@ -16,8 +29,8 @@ void VinsNode::set_frame_hooks(std::function<void(const CameraFrame&)> before_fr
   after_update_ = std::move(after_update);
 }
 
-void VinsNode::say(VinsEvent::Kind kind, const std::string& message) {
-  if (on_event_) on_event_(VinsEvent{kind, message});
+void VinsNode::say(NodeEvent::Kind kind, const std::string& message) {
+  if (on_event_) on_event_(NodeEvent{kind, message});
 }
 
 void VinsNode::on_imu(const ImuData& imu) {
@@ -26,10 +39,10 @@ void VinsNode::on_imu(const ImuData& imu) {
     case estimator::ImuFeedStatus::kAccepted:
       break;
     case estimator::ImuFeedStatus::kAcceptedAfterGap:
-      say(VinsEvent::Kind::kInfo, "IMU gap before utime " + std::to_string(imu.utime) + " (propagating across it)");
+      say(NodeEvent::Kind::kInfo, "IMU gap before utime " + std::to_string(imu.utime) + " (propagating across it)");
       break;
     default:
-      say(VinsEvent::Kind::kDropped,
+      say(NodeEvent::Kind::kDropped,
           std::string("IMU sample at utime ") + std::to_string(imu.utime) + ": " + estimator::to_string(status));
       return;
   }
@@ -39,7 +52,7 @@ void VinsNode::on_imu(const ImuData& imu) {
 
 void VinsNode::on_frame(const CameraFrame& frame) {
   if (frame.utime <= last_frame_utime_) {
-    say(VinsEvent::Kind::kDropped, "camera frame at utime " + std::to_string(frame.utime) +
+    say(NodeEvent::Kind::kDropped, "camera frame at utime " + std::to_string(frame.utime) +
                                        (frame.utime == last_frame_utime_ ? " is a duplicate" : " is out of order"));
     return;
   }
@@ -47,7 +60,7 @@ void VinsNode::on_frame(const CameraFrame& frame) {
   queued_frames_.push_back(frame);
   process_ready_frames(estimator_.propagator().latest_utime());
   while (static_cast<int>(queued_frames_.size()) > options_.max_queued_frames) {
-    say(VinsEvent::Kind::kInfo, "IMU stalled: processing frame " + std::to_string(queued_frames_.front().utime) +
+    say(NodeEvent::Kind::kInfo, "IMU stalled: processing frame " + std::to_string(queued_frames_.front().utime) +
                                     " without IMU up to its time");
     process_frame(queued_frames_.front());
     queued_frames_.pop_front();
@@ -63,9 +76,9 @@ void VinsNode::flush() {
 
 void VinsNode::on_ground_truth(const GroundTruth& truth) {
   if (!options_.init_from_ground_truth || estimator_.initialized()) return;
-  const eval::InitialEstimate init = eval::initial_estimate(truth, options_.vio, options_.perturb_seed);
+  const estimator::InitialEstimate init = estimator::initial_estimate(truth, options_.vio, options_.perturb_seed);
   estimator_.initialize(init.value, truth.utime, init.P0);
-  say(VinsEvent::Kind::kInfo, "initialised from ground truth at utime " + std::to_string(truth.utime));
+  say(NodeEvent::Kind::kInfo, "initialised from ground truth at utime " + std::to_string(truth.utime));
 }
 
 void VinsNode::process_ready_frames(int64_t latest_imu_utime) {
@@ -89,21 +102,21 @@ void VinsNode::process_frame(const CameraFrame& frame) {
       msg << "estimator diverged at utime " << frame.utime << " (" << estimator_.last_divergence().reason
           << "); reset, re-initialising " << (options_.init_from_ground_truth ? "from ground truth" : "at rest");
       estimator_.reset();
-      say(VinsEvent::Kind::kError, msg.str());
+      say(NodeEvent::Kind::kError, msg.str());
       return;
     }
     case estimator::FrameStatus::kNotInitialized:
-      say(VinsEvent::Kind::kDropped, "frame at utime " + std::to_string(frame.utime) + " before initialisation");
+      say(NodeEvent::Kind::kDropped, "frame at utime " + std::to_string(frame.utime) + " before initialisation");
       return;
     default:
-      say(VinsEvent::Kind::kDropped,
+      say(NodeEvent::Kind::kDropped,
           "frame at utime " + std::to_string(frame.utime) + ": " + estimator::to_string(status));
       return;
   }
 }
 
 void VinsNode::publish_updated() {
-  if (on_state_) on_state_(eval::nav_state_of(estimator_, /*updated=*/true));
+  if (on_state_) on_state_(estimator::nav_state_of(estimator_, /*updated=*/true));
 }
 
 void VinsNode::publish_propagated(int64_t utime) {
@@ -117,7 +130,7 @@ void VinsNode::publish_propagated(int64_t utime) {
   if (!estimator_.propagator().predict_interval(x0, x0, estimator_.state_utime(), utime, &x1, &Phi, &Q, &report)) {
     return;
   }
-  NavState s = eval::nav_state_of(estimator_, /*updated=*/false);
+  NavState s = estimator::nav_state_of(estimator_, /*updated=*/false);
   s.utime = utime;
   s.q_GtoI = x1.q_GtoI;
   s.p_IinG = x1.p_IinG;

@@ -15,7 +15,9 @@
 #include <functional>
 #include <string>
 
+#include "common/config/config.h"
 #include "common/estimator/vio_estimator.h"
+#include "common/process/node_event.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
 #include "common/types/sensor_data.h"
@@ -36,16 +38,15 @@ struct VinsNodeOptions {
   int max_queued_frames{5};
 };
 
-/// What happened to an input, for the process's counters and log.
-struct VinsEvent {
-  enum class Kind { kInfo, kDropped, kError } kind{Kind::kInfo};
-  std::string message;
-};
+/// The process's options from a vins config (config/vins.yaml, layout in
+/// common/estimator/vins_config.h): estimator, init, output.imu_rate.
+/// Throws ConfigError naming the file and key, also for an unknown key.
+VinsNodeOptions vins_node_options_from_config(const Config& cfg);
 
 class VinsNode {
  public:
   using StateCallback = std::function<void(const NavState&)>;
-  using EventCallback = std::function<void(const VinsEvent&)>;
+  using EventCallback = std::function<void(const NodeEvent&)>;
 
   VinsNode(const VinsNodeOptions& options, StateCallback on_state, EventCallback on_event);
 
@@ -72,7 +73,7 @@ class VinsNode {
   void process_frame(const CameraFrame& frame);
   void publish_updated();
   void publish_propagated(int64_t utime);
-  void say(VinsEvent::Kind kind, const std::string& message);
+  void say(NodeEvent::Kind kind, const std::string& message);
 
   VinsNodeOptions options_;
   estimator::VioEstimator estimator_;

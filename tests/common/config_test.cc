@@ -82,6 +82,44 @@ TEST_CASE("missing and malformed files are reported, ASL headers accepted") {
   CHECK(asl.get<int>("rate_hz") == 20);
 }
 
+TEST_CASE("a directory or an empty file as a config says so") {
+  const std::string dir = message_of([] { Config::load_file("/tmp"); });
+  CHECK(dir.find("'/tmp'") != std::string::npos);
+  CHECK(dir.find("is a directory") != std::string::npos);
+  const std::string path = "/tmp/vimot_config_test_empty.yaml";
+  std::ofstream(path) << "# only a comment\n";
+  const std::string empty = message_of([&] { Config::load_file(path); });
+  std::remove(path.c_str());
+  CHECK(empty.find(path) != std::string::npos);
+  CHECK(empty.find("is empty") != std::string::npos);
+}
+
+TEST_CASE("a key repeated in one map is refused with its path, line and value") {
+  const std::string top = message_of([] { Config::from_string("a: 1\nb: 2\na: 3\n", "dup.yaml"); });
+  CHECK(top.find("config 'dup.yaml': key 'a' is repeated (line 3, value '3')") != std::string::npos);
+  const std::string nested =
+      message_of([] { Config::from_string("estimator:\n  triangulation: {min_depth: 1, min_depth: 2}\n", "d.yaml"); });
+  CHECK(nested.find("key 'estimator.triangulation.min_depth' is repeated") != std::string::npos);
+  CHECK(nested.find("value '2'") != std::string::npos);
+  // The same key in different maps is fine.
+  CHECK_NOTHROW(Config::from_string("a: {x: 1}\nb: {x: 2}\n", "ok.yaml"));
+}
+
+TEST_CASE("check_keys refuses an unknown key naming file, full path and value") {
+  const Config c = Config::from_string("estimator:\n  num_clonez: 5\n  init: {sigma_p: 1}\nchannelz: {imu: IMU}\n",
+                                       "v.yaml");
+  const std::string nested = message_of([&] { c.check_keys("estimator", {"num_clones", "init"}); });
+  CHECK(nested.find("config 'v.yaml': key 'estimator.num_clonez' (value '5') is unknown "
+                    "(known keys: num_clones, init)") != std::string::npos);
+  const std::string section = message_of([&] { c.check_keys("", {"estimator", "channels"}); });
+  CHECK(section.find("key 'channelz' (value '{imu: IMU}') is unknown") != std::string::npos);
+  // Through a sub-tree the full path is kept; an absent section passes.
+  const std::string sub = message_of([&] { c.sub("estimator").check_keys("init", {"sigma_v"}); });
+  CHECK(sub.find("key 'estimator.init.sigma_p' (value '1')") != std::string::npos);
+  CHECK_NOTHROW(c.check_keys("absent", {}));
+  CHECK_NOTHROW(c.check_keys("estimator", {"num_clonez", "init"}));
+}
+
 TEST_CASE("utime conversions round to the nearest microsecond") {
   CHECK(vimot::seconds_to_utime(1.0) == 1000000);
   CHECK(vimot::seconds_to_utime(0.005) == 5000);

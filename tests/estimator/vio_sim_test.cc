@@ -10,10 +10,10 @@
 #include <functional>
 
 #include "common/config/config.h"
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/vins_config.h"
 #include "common/estimator/vio_estimator.h"
-#include "common/eval/initial_estimate.h"
 #include "common/eval/sim_runner.h"
-#include "common/eval/vins_config.h"
 #include "common/math/quat.h"
 #include "common/sim/simulator.h"
 #include "common/types/ground_truth.h"
@@ -37,7 +37,7 @@ sim::SimConfig paper_config(uint64_t seed, double duration) {
 // model equals the simulator's: tests/eval/vins_config_test.cc), with a
 // small initial covariance: P0 = diag(1e-6 I, 1e-6 I, 1e-6 I, 1e-8 I, 1e-6 I).
 VioOptions estimator_options() {
-  VioOptions o = eval::load_vio_options(source_path("config/vins.yaml"));
+  VioOptions o = estimator::load_vio_options(source_path("config/vins.yaml"));
   o.init_sigmas.theta_rp = 1e-3;
   o.init_sigmas.theta_yaw = 1e-3;
   o.init_sigmas.p = 1e-3;
@@ -68,7 +68,7 @@ RunResult run(uint64_t seed, double duration, const std::function<void(VioOption
     const auto& C = est.state().cov();
     out.trace.insert(out.trace.end(), C.data(), C.data() + C.size());
   };
-  out.eval = eval::run_vio_on_sim(paper_config(seed, duration), opt, eval::perturb_seed_for_run(seed), ro);
+  out.eval = eval::run_vio_on_sim(paper_config(seed, duration), opt, estimator::perturb_seed_for_run(seed), ro);
   const eval::SimRunResult& r = out.eval;
   std::printf("seed %llu: %lld frames, path %.1f m, RMSE %.3f m / %.3f deg, NEES pos %.2f ori %.2f, "
               "%.2f ms/frame CPU (max %.2f), MSCKF used %d (chi2 rej %d, tri rej %d, short %d, over max %d), "

@@ -14,17 +14,19 @@
 #include <unistd.h>
 
 #include "common/config/config.h"
+#include "common/estimator/nav_state_of.h"
+#include "common/estimator/vins_config.h"
 #include "common/eval/json.h"
-#include "common/eval/nav_state_of.h"
+#include "common/eval/log_eval.h"
 #include "common/eval/sim_runner.h"
-#include "common/eval/vins_config.h"
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/process/lcm_conversions.h"
-#include "procs/eval/log_eval.h"
 
 using namespace vimot;
 using namespace vimot::eval;
+using estimator::load_vio_options;
+using estimator::nav_state_of;
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 

@@ -6,13 +6,16 @@
 #include <set>
 
 #include "common/config/config.h"
+#include "common/estimator/initial_estimate.h"
 #include "common/eval/alignment.h"
-#include "common/eval/initial_estimate.h"
 #include "common/eval/metrics.h"
 #include "common/math/quat.h"
 
 using namespace vimot;
 using namespace vimot::eval;
+using estimator::InitialEstimate;
+using estimator::initial_estimate;
+using estimator::perturb_seed_for_run;
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 

@@ -8,9 +8,9 @@
 #include <cstdio>
 
 #include "common/eval/json.h"
+#include "common/eval/scale_eval.h"
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
-#include "procs/eval/scale_eval.h"
 
 using namespace vimot;
 using namespace vimot::eval;

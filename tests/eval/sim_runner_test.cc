@@ -7,16 +7,21 @@
 #include <cmath>
 
 #include "common/config/config.h"
-#include "common/eval/initial_estimate.h"
-#include "common/eval/nav_state_of.h"
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/nav_state_of.h"
+#include "common/estimator/vins_config.h"
+#include "common/eval/json.h"
 #include "common/eval/report.h"
 #include "common/eval/sim_runner.h"
-#include "common/eval/vins_config.h"
-#include "common/eval/json.h"
 #include "common/sim/simulator.h"
 
 using namespace vimot;
 using namespace vimot::eval;
+using estimator::InitialEstimate;
+using estimator::initial_estimate;
+using estimator::load_vio_options;
+using estimator::nav_state_of;
+using estimator::perturb_seed_for_run;
 
 namespace {
 

@@ -9,13 +9,14 @@
 #include <string>
 
 #include "common/config/config.h"
+#include "common/estimator/vins_config.h"
 #include "common/eval/target_eval.h"
-#include "common/eval/vins_config.h"
 #include "common/eval/writers.h"
 #include "common/sim/simulator.h"
 
 using namespace vimot;
 using namespace vimot::eval;
+using estimator::load_vio_options;
 
 namespace {
 
@@ -46,7 +47,7 @@ TEST_CASE("target sweep: SKF leaves the IMU RMSE of VIO only; thread count does 
   sim::SimConfig sim_cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
   sim_cfg.duration = 10.0;
   const estimator::VioOptions vo = load_vio_options(source_path("config/vins.yaml"));
-  const target::TargetFilterOptions f = load_target_filter_options(source_path("config/target_filter.yaml"));
+  const target::TargetFilterOptions f = target_filter_options(Config::load_file(source_path("config/target_filter.yaml")));
 
   const std::vector<TargetCell> a = run_target_sweep(sim_cfg, vo, f, one_cell(1));
   const std::vector<TargetCell> b = run_target_sweep(sim_cfg, vo, f, one_cell(2));
@@ -118,7 +119,7 @@ TEST_CASE("target sweep: SKF leaves the IMU RMSE of VIO only; thread count does 
 }
 
 TEST_CASE("target config: keys and errors", "[eval][target]") {
-  const target::TargetFilterOptions f = load_target_filter_options(source_path("config/target_filter.yaml"));
+  const target::TargetFilterOptions f = target_filter_options(Config::load_file(source_path("config/target_filter.yaml")));
   CHECK(f.mode == target::TargetUpdateMode::kSkf);
   CHECK(f.representation == target::TargetRepresentation::kLocal);
   CHECK(f.planar);

@@ -9,11 +9,15 @@
 #include <unistd.h>
 
 #include "common/config/config.h"
-#include "common/eval/vins_config.h"
+#include "common/estimator/vins_config.h"
+#include "common/eval/evaluation_setup.h"
 #include "common/sim/simulator.h"
 
 using namespace vimot;
 using namespace vimot::eval;
+using estimator::VinsStartOptions;
+using estimator::load_start_options;
+using estimator::load_vio_options;
 using estimator::VioOptions;
 
 namespace {

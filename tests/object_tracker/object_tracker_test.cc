@@ -37,11 +37,11 @@
 #include <random>
 
 #include "common/config/config.h"
+#include "common/eval/object_truth.h"
 #include "common/math/quat.h"
+#include "common/object/object_tracker.h"
 #include "common/sim/sim_config.h"
 #include "common/sim/simulator.h"
-#include "procs/object_tracker/object_tracker.h"
-#include "procs/eval/object_truth.h"
 
 namespace vimot {
 namespace {
@@ -275,10 +275,12 @@ TEST_CASE("options from a YAML section, with validation", "[object_tracker]") {
   CHECK(o.window_size == 20);
   CHECK(o.robust_loss == defaults.robust_loss);
   CHECK(o.min_init_features == defaults.min_init_features);
-  CHECK_THROWS_AS(object_tracker_options_from_config(Config::from_string("object_tracker: {robust_loss: l2}")),
-                  std::invalid_argument);
-  CHECK_THROWS_AS(object_tracker_options_from_config(Config::from_string("object_tracker: {window_size: 2}")),
-                  std::invalid_argument);
+  CHECK_THROWS_WITH(object_tracker_options_from_config(Config::from_string("object_tracker: {robust_loss: l2}")),
+                    Catch::Contains("key 'object_tracker.robust_loss' must be huber or cauchy, got l2"));
+  CHECK_THROWS_WITH(object_tracker_options_from_config(Config::from_string("object_tracker: {window_size: 2}")),
+                    Catch::Contains("key 'object_tracker.window_size' must be >= 3, got 2"));
+  CHECK_THROWS_WITH(object_tracker_options_from_config(Config::from_string("object_tracker: {window_sise: 9}")),
+                    Catch::Contains("key 'object_tracker.window_sise' (value '9') is unknown"));
 }
 
 }  // namespace

@@ -12,7 +12,7 @@
 #include <variant>
 
 #include "common/config/config.h"
-#include "common/eval/vins_config.h"
+
 #include "common/math/quat.h"
 #include "common/process/lcm_conversions.h"
 #include "common/sim/simulator.h"
@@ -66,7 +66,7 @@ std::vector<NavState> run_vins(const std::vector<sim::SimEvent>& events, const T
   options.perturb_seed = tf.perturb_seed;
   std::vector<NavState> updated;
   VinsNode node(
-      options, [&](const NavState& s) { if (s.updated) updated.push_back(s); }, [](const VinsEvent&) {});
+      options, [&](const NavState& s) { if (s.updated) updated.push_back(s); }, [](const NodeEvent&) {});
   feed(node, events);
   return updated;
 }

@@ -9,10 +9,11 @@
 #include <variant>
 
 #include "common/config/config.h"
-#include "common/eval/vins_config.h"
+#include "common/estimator/vins_config.h"
+#include "common/eval/sim_runner.h"
 #include "common/sim/simulator.h"
-#include "tests/procs/paper_events.h"
 #include "procs/vins/vins_node.h"
+#include "tests/procs/paper_events.h"
 
 using namespace vimot;
 
@@ -21,17 +22,17 @@ namespace {
 struct Outputs {
   std::vector<NavState> updated;
   std::vector<NavState> propagated;
-  std::vector<VinsEvent> events;
+  std::vector<NodeEvent> events;
 };
 
 Outputs run_node(const std::vector<sim::SimEvent>& events) {
   VinsNodeOptions options;
-  options.vio = eval::load_vio_options(source_path("config/vins.yaml"));
+  options.vio = estimator::load_vio_options(source_path("config/vins.yaml"));
   Outputs out;
   VinsNode node(
       options,
       [&](const NavState& s) { (s.updated ? out.updated : out.propagated).push_back(s); },
-      [&](const VinsEvent& e) { out.events.push_back(e); });
+      [&](const NodeEvent& e) { out.events.push_back(e); });
   for (const auto& e : events) {
     if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
     if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
@@ -72,6 +73,39 @@ TEST_CASE("vins node output does not depend on message interleaving", "[vins]") 
   CHECK(same_states(in_order.updated, reordered.updated));
 }
 
+TEST_CASE("vins node publishes exactly the offline evaluator's states", "[vins]") {
+  // Offline equals LCM: the same scenario, options and perturbation through
+  // the evaluator (eval::run_vio_on_sim) and through the process logic.
+  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
+  cfg.seed = 5;
+  cfg.duration = 8.0;
+  cfg.ground_truth_events = true;
+  VinsNodeOptions options;
+  options.vio = estimator::load_vio_options(source_path("config/vins.yaml"));
+  options.perturb_seed = 9;
+  options.publish_imu_rate = false;
+  const eval::SimRunResult offline = eval::run_vio_on_sim(cfg, options.vio, options.perturb_seed);
+  REQUIRE(offline.samples.size() >= 75);
+
+  std::vector<NavState> updated;
+  VinsNode node(options, [&](const NavState& s) { updated.push_back(s); }, {});
+  sim::Simulator(cfg).run([&](const sim::SimEvent& e) {
+    if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
+    if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
+    if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
+  });
+  node.flush();
+  REQUIRE(updated.size() == offline.samples.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < updated.size(); ++i) {
+    const eval::FrameSample& o = offline.samples[i];
+    const NavState& n = updated[i];
+    differing += n.utime != o.utime || n.q_GtoI != o.q_GtoI || n.p_IinG != o.p_IinG || n.v_IinG != o.v_IinG ||
+                 n.covariance.diagonal() != o.cov_diag;
+  }
+  CHECK(differing == 0);
+}
+
 TEST_CASE("vins node drops duplicate, out-of-order and non-finite input without effect", "[vins]") {
   const std::vector<sim::SimEvent> events = simulate(5.0);
   const Outputs clean = run_node(events);
@@ -98,9 +132,9 @@ TEST_CASE("vins node drops duplicate, out-of-order and non-finite input without 
   const Outputs out = run_node(dirty);
   CHECK(same_states(clean.updated, out.updated));
   int dropped = 0;
-  for (const auto& e : out.events) dropped += e.kind == VinsEvent::Kind::kDropped;
+  for (const auto& e : out.events) dropped += e.kind == NodeEvent::Kind::kDropped;
   int clean_dropped = 0;
-  for (const auto& e : clean.events) clean_dropped += e.kind == VinsEvent::Kind::kDropped;
+  for (const auto& e : clean.events) clean_dropped += e.kind == NodeEvent::Kind::kDropped;
   CHECK(dropped > clean_dropped);
 }
 

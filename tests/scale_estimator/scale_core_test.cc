@@ -8,7 +8,7 @@
 
 #include "common/config/config.h"
 #include "common/math/quat.h"
-#include "procs/scale_estimator/scale_estimator.h"
+#include "common/object/scale_estimator.h"
 
 using namespace vimot;
 using namespace vimot::scale;

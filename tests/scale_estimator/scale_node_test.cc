@@ -55,7 +55,7 @@ ObjectPoseEstimate pose_of(const ScaleObservation& o) {
 struct Outputs {
   std::vector<ScaleResult> scales;
   std::vector<ObjectPoseInWorld> poses;
-  std::vector<VinsEvent> events;
+  std::vector<NodeEvent> events;
 };
 
 ScaleNode make_node(Outputs* out, int max_pending = 10) {
@@ -65,7 +65,7 @@ ScaleNode make_node(Outputs* out, int max_pending = 10) {
   return ScaleNode(
       o, [out](const ScaleResult& r) { out->scales.push_back(r); },
       [out](const ObjectPoseInWorld& p) { out->poses.push_back(p); },
-      [out](const VinsEvent& e) { out->events.push_back(e); });
+      [out](const NodeEvent& e) { out->events.push_back(e); });
 }
 
 }  // namespace
@@ -170,7 +170,7 @@ TEST_CASE("scale_node: a side that lags is buffered; passed or overflowing messa
   CHECK(node.stats().rejected_observations == 1);
   CHECK(node.estimator().window().size() == 8);
   int dropped = 0;
-  for (const VinsEvent& e : out.events) dropped += e.kind == VinsEvent::Kind::kDropped;
+  for (const NodeEvent& e : out.events) dropped += e.kind == NodeEvent::Kind::kDropped;
   CHECK(dropped == 1 + 3 + 2 + 1);
 }
 

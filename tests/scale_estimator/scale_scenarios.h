@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 
 #include "common/math/quat.h"
-#include "procs/scale_estimator/scale_estimator.h"
+#include "common/object/scale_estimator.h"
 
 namespace vimot::scale::testing {
 

@@ -23,9 +23,9 @@
 
 #include "common/config/config.h"
 #include "common/math/quat.h"
+#include "common/object/scale_estimator.h"
 #include "common/sim/sim_config.h"
 #include "common/sim/simulator.h"
-#include "procs/scale_estimator/scale_estimator.h"
 #include "procs/scale_estimator/scale_node.h"
 
 using namespace vimot;

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "common/config/config.h"
+#include "common/estimator/initial_estimate.h"
+#include "common/estimator/vins_config.h"
 #include "common/estimator/vio_estimator.h"
-#include "common/eval/initial_estimate.h"
-#include "common/eval/vins_config.h"
 #include "common/math/quat.h"
 #include "common/sim/sim_config.h"
 #include "common/sim/simulator.h"
@@ -39,7 +39,7 @@ constexpr double kDuration = 20.0;
 std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
 
 VioOptions estimator_options() {
-  VioOptions o = eval::load_vio_options(source_path("config/vins.yaml"));
+  VioOptions o = estimator::load_vio_options(source_path("config/vins.yaml"));
   o.init_sigmas.theta_rp = 1e-3;
   o.init_sigmas.theta_yaw = 1e-3;
   o.init_sigmas.p = 1e-3;
@@ -73,7 +73,7 @@ Run run(const std::optional<TargetFilterOptions>& options, uint64_t seed = kSeed
   sim::Simulator sim(cfg);
   const VioOptions vo = estimator_options();
   VioEstimator est(vo);
-  const eval::InitialEstimate x0 = eval::initial_estimate(sim.initial_state(), vo, eval::perturb_seed_for_run(seed));
+  const estimator::InitialEstimate x0 = estimator::initial_estimate(sim.initial_state(), vo, estimator::perturb_seed_for_run(seed));
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
   std::unique_ptr<TargetFilter> filter;
   if (options) filter = std::make_unique<TargetFilter>(est, *options);

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "common/estimator/vio_estimator.h"
-#include "common/eval/vins_config.h"
+#include "common/estimator/vins_config.h"
 #include "common/math/quat.h"
 #include "common/time/utime.h"
 #include "drivers/euroc_player/euroc_player.h"
@@ -24,7 +24,7 @@ double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 TEST_CASE("static initialisation on the slice's IMU agrees with its ground truth", "[euroc][data]") {
   const vimot::estimator::VioOptions options =
-      vimot::eval::load_vio_options(std::string(VIMOT_SOURCE_DIR) + "/config/vins_euroc.yaml");
+      vimot::estimator::load_vio_options(std::string(VIMOT_SOURCE_DIR) + "/config/vins_euroc.yaml");
   REQUIRE(options.init_mode == vimot::estimator::InitMode::kStatic);
   vimot::estimator::VioEstimator estimator(options);
 

@@ -1,8 +1,7 @@
-#include "procs/scale_estimator/scale_estimator.h"
+#include "common/object/scale_estimator.h"
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 #include <stdexcept>
 
 #include "common/math/quat.h"
@@ -27,18 +26,11 @@ bool finite4(const Eigen::Vector4d& v) { return v.allFinite(); }
 ScaleEstimatorOptions ScaleEstimatorOptions::from_config(const Config& cfg,
                                                          const std::string& section) {
   ScaleEstimatorOptions o;
-  static const char* kKeys[] = {"window_size",   "min_observations",      "derivative_order",
-                                "motion_lowpass_s", "motion_highpass_s",
-                                "epsilon_t1",    "rho_t1",                "rho_t2",
-                                "relative_condition_i", "require_positive_scale",
-                                "max_gap_s",     "quat_norm_tolerance"};
   const std::string s = section.empty() ? "" : section + ".";
   if (!section.empty() && !cfg.has(section)) return o;  // whole section optional
-  const Config sec = section.empty() ? cfg : cfg.sub(section);
-  const std::set<std::string> known(std::begin(kKeys), std::end(kKeys));
-  for (const std::string& k : sec.keys()) {
-    if (!known.count(k)) sec.fail(k, "is not a scale_estimator option");
-  }
+  cfg.check_keys(section, {"window_size", "min_observations", "derivative_order", "motion_lowpass_s",
+                           "motion_highpass_s", "epsilon_t1", "rho_t1", "rho_t2", "relative_condition_i",
+                           "require_positive_scale", "max_gap_s", "quat_norm_tolerance"});
   read(cfg, s + "window_size", &o.window_size);
   read(cfg, s + "min_observations", &o.min_observations);
   read(cfg, s + "derivative_order", &o.derivative_order);

@@ -1,12 +1,10 @@
 #pragma once
-// The monocular metric-scale pipeline of the scale paper (Qiu et al.,
-// Sec. III-IV) on the simulator, offline and in-process, evaluated against
-// its truth (vimot-scale-eval). The same cores as the LCM processes, fed in
-// the same order: per camera frame VioEstimator (mono) -> NavState,
-// ObjectTracker -> up-to-scale object pose, ScaleNode (pairing by utime,
-// correlation estimator, held scale, Eq. 20-21). No LCM here.
+// Evaluation of the monocular metric-scale pipeline of the scale paper
+// (Qiu et al., Sec. III-IV) against the simulator's truth, for an offline
+// run (procs/eval/scale_run.h, vimot-scale-eval) and for a recorded LCM run
+// (common/eval/log_eval.h, vimot-log-eval) alike. No LCM here.
 //
-// Truth per tracker track (procs/eval/object_truth.h): s_true and the object
+// Truth per tracker track (common/eval/object_truth.h): s_true and the object
 // frame O rigid in the target T. Reported as the paper reports its trials:
 //  * scale: relative error ŝ/s_true − 1 of every accepted estimate (median,
 //    max |·|) and of the scale held at the end;
@@ -20,28 +18,17 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "common/estimator/vio_estimator.h"
 #include "common/eval/json.h"
 #include "common/eval/metrics.h"
-#include "common/sim/sim_config.h"
+#include "common/eval/object_truth.h"
 #include "common/types/target_state.h"
-#include "procs/eval/object_truth.h"
-#include "procs/object_tracker/object_tracker.h"
-#include "procs/scale_estimator/scale_node.h"
 
 namespace vimot {
 namespace eval {
-
-struct ScaleEvalOptions {
-  estimator::VioOptions vio;
-  ObjectTrackerOptions tracker;
-  ScaleNodeOptions node;
-};
 
 /// One published metric object pose against the truth.
 struct MetricPoseSample {
@@ -132,12 +119,6 @@ struct ScaleRunResult {
   std::string divergence_reason;
   double wall_s{0.0};
 };
-
-/// One run on `sim_config` (mono scenario with a target). perturb_seed 0 =
-/// the VIO starts at the truth. `progress` gets the fraction of frames done.
-/// Throws std::invalid_argument on a scenario without a target or camera.
-ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEvalOptions& options,
-                                uint64_t perturb_seed, const std::function<void(double)>& progress = {});
 
 /// The median of |errors| and the largest |error|; zeros when empty.
 struct AbsStats {

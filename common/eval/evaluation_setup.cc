@@ -1,22 +1,15 @@
-#include "common/eval/vins_config.h"
-
-#include <stdexcept>
+#include "common/eval/evaluation_setup.h"
 
 #include <sstream>
+#include <stdexcept>
 
 #include "common/config/config.h"
+#include "common/estimator/vins_config.h"
 
 namespace vimot {
 namespace eval {
 
 namespace {
-
-estimator::InitMode read_mode(const Config& cfg) {
-  const std::string mode = cfg.get_or<std::string>("init.mode", "ground_truth");
-  if (mode == "ground_truth") return estimator::InitMode::kGroundTruth;
-  if (mode == "static") return estimator::InitMode::kStatic;
-  cfg.fail("init.mode", "must be 'ground_truth' or 'static', got '" + mode + "'");
-}
 
 std::string num(double v) {
   std::ostringstream s;
@@ -31,35 +24,6 @@ bool same_camera(const CameraCalibration& a, const CameraCalibration& b) {
 }
 
 }  // namespace
-
-estimator::VioOptions vio_options_from_config(const Config& cfg) {
-  if (cfg.has("estimator.init.mode")) {
-    cfg.fail("estimator.init.mode", "is set by the top-level 'init.mode' of a vins config");
-  }
-  const bool has_calib = cfg.has("calibration_file");
-  const Config calib = has_calib ? Config::load_file(cfg.resolve_path(cfg.get<std::string>("calibration_file")))
-                                 : cfg;
-  estimator::VioOptions o = estimator::VioOptions::from_config(cfg, calib, "estimator");
-  o.init_mode = read_mode(cfg);
-  return o;
-}
-
-estimator::VioOptions load_vio_options(const std::string& vins_yaml) {
-  return vio_options_from_config(Config::load_file(vins_yaml));
-}
-
-VinsStartOptions start_options_from_config(const Config& cfg) {
-  VinsStartOptions s;
-  s.mode = read_mode(cfg);
-  const int64_t seed = cfg.get_or<int64_t>("init.perturb_seed", 0);
-  if (seed < 0) cfg.fail("init.perturb_seed", "must be >= 0 (0 = no perturbation), got " + std::to_string(seed));
-  s.perturb_seed = static_cast<uint64_t>(seed);
-  return s;
-}
-
-VinsStartOptions load_start_options(const std::string& vins_yaml) {
-  return start_options_from_config(Config::load_file(vins_yaml));
-}
 
 std::vector<std::string> model_mismatches(const estimator::VioOptions& o, const sim::SimConfig& s) {
   std::vector<std::string> out;
@@ -114,7 +78,7 @@ EvaluationSetup load_evaluation_setup(const std::string& sim_yaml, const std::st
     }
     setup.sim.duration = *duration_s;
   }
-  setup.vio = load_vio_options(vins_yaml);
+  setup.vio = estimator::load_vio_options(vins_yaml);
   setup.model_mismatches = model_mismatches(setup.vio, setup.sim);
   return setup;
 }

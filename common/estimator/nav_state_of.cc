@@ -1,11 +1,11 @@
-#include "common/eval/nav_state_of.h"
+#include "common/estimator/nav_state_of.h"
 
 namespace vimot {
-namespace eval {
+namespace estimator {
 
-NavState nav_state_of(const estimator::VioEstimator& est, bool updated) {
+NavState nav_state_of(const VioEstimator& est, bool updated) {
   NavState s;
-  const estimator::ImuValue x = est.imu_value();
+  const ImuValue x = est.imu_value();
   s.utime = est.state_utime();
   s.updated = updated;
   s.q_GtoI = x.q_GtoI;
@@ -20,5 +20,5 @@ NavState nav_state_of(const estimator::VioEstimator& est, bool updated) {
   return s;
 }
 
-}  // namespace eval
+}  // namespace estimator
 }  // namespace vimot

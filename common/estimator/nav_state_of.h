@@ -7,12 +7,12 @@
 #include "common/types/nav_state.h"
 
 namespace vimot {
-namespace eval {
+namespace estimator {
 
 /// The estimator's current IMU state: utime = state time, q/p/v/biases,
 /// the 15×15 IMU covariance [δθ δp δv δbg δba], clone and SLAM counts, and
 /// (updated = true only) the MSCKF features of the last update.
-NavState nav_state_of(const estimator::VioEstimator& estimator, bool updated);
+NavState nav_state_of(const VioEstimator& estimator, bool updated);
 
-}  // namespace eval
+}  // namespace estimator
 }  // namespace vimot

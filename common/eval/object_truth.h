@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/object/object_tracker.h"
 #include "common/sim/simulator.h"
-#include "procs/object_tracker/object_tracker.h"
 
 namespace vimot {
 namespace eval {

@@ -23,20 +23,20 @@
 #include "common/types/ground_truth.h"
 
 namespace vimot {
-namespace eval {
+namespace estimator {
 
 struct InitialEstimate {
-  estimator::ImuValue value;  // x̂0
-  estimator::Matrix15d P0{estimator::Matrix15d::Zero()};  // [δθ δp δv δbg δba]
+  ImuValue value;  // x̂0
+  Matrix15d P0{Matrix15d::Zero()};  // [δθ δp δv δbg δba]
 };
 
 /// x̂0 and P0 from the true state (q, p, v and the true biases of `truth`).
-InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioOptions& options,
+InitialEstimate initial_estimate(const GroundTruth& truth, const VioOptions& options,
                                  uint64_t perturb_seed);
 
 /// Perturbation seed of Monte-Carlo run with simulator seed `sim_seed`
 /// (splitmix64 of it, never 0), so runs are independent and reproducible.
 uint64_t perturb_seed_for_run(uint64_t sim_seed);
 
-}  // namespace eval
+}  // namespace estimator
 }  // namespace vimot

@@ -1,15 +1,15 @@
 #pragma once
-// The LCM side shared by the estimator processes (vins, target_filter): how
-// a node's events reach the heartbeat counters, and the subscribe → run
-// loop with the bounded IMU wait. A node has on_imu, on_frame,
+// The LCM side shared by the process nodes: how a node's events reach the
+// heartbeat counters (every node), and the subscribe → run loop with the
+// bounded IMU wait of the estimator nodes, which have on_imu, on_frame,
 // on_ground_truth and flush (VinsNode, TargetFilterNode).
 
 #include <chrono>
 #include <functional>
 
 #include "common/process/lcm_conversions.h"
+#include "common/process/node_event.h"
 #include "common/process/process.h"
-#include "procs/vins/vins_node.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
 #include "vimot/imu_t.hpp"
@@ -17,12 +17,12 @@
 namespace vimot {
 
 /// Info is logged; dropped input and errors are counted in the heartbeat.
-inline std::function<void(const VinsEvent&)> report_events_to(Process& process) {
-  return [&process](const VinsEvent& e) {
+inline std::function<void(const NodeEvent&)> report_events_to(Process& process) {
+  return [&process](const NodeEvent& e) {
     switch (e.kind) {
-      case VinsEvent::Kind::kInfo: log_info(e.message); break;
-      case VinsEvent::Kind::kDropped: process.report_dropped(e.message); break;
-      case VinsEvent::Kind::kError: process.report_error(e.message); break;
+      case NodeEvent::Kind::kInfo: log_info(e.message); break;
+      case NodeEvent::Kind::kDropped: process.report_dropped(e.message); break;
+      case NodeEvent::Kind::kError: process.report_error(e.message); break;
     }
   };
 }

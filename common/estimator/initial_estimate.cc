@@ -1,4 +1,4 @@
-#include "common/eval/initial_estimate.h"
+#include "common/estimator/initial_estimate.h"
 
 #include <Eigen/Cholesky>
 #include <random>
@@ -7,9 +7,9 @@
 #include "common/math/quat.h"
 
 namespace vimot {
-namespace eval {
+namespace estimator {
 
-InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioOptions& options,
+InitialEstimate initial_estimate(const GroundTruth& truth, const VioOptions& options,
                                  uint64_t perturb_seed) {
   InitialEstimate init;
   init.value.q_GtoI = quat_normalize(truth.q_GtoI);
@@ -17,10 +17,10 @@ InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioO
   init.value.v_IinG = truth.v_IinG;
   init.value.bg = truth.bias_gyro;
   init.value.ba = truth.bias_accel;
-  init.P0 = estimator::initial_covariance(init.value.q_GtoI, options.init_sigmas);
+  init.P0 = initial_covariance(init.value.q_GtoI, options.init_sigmas);
   if (perturb_seed == 0) return init;
 
-  const Eigen::LLT<estimator::Matrix15d> llt(init.P0);
+  const Eigen::LLT<Matrix15d> llt(init.P0);
   if (llt.info() != Eigen::Success) {
     throw std::invalid_argument("initial_estimate: P0 from init_sigmas is not positive definite");
   }
@@ -29,7 +29,7 @@ InitialEstimate initial_estimate(const GroundTruth& truth, const estimator::VioO
   Eigen::Matrix<double, 15, 1> n;
   for (int i = 0; i < 15; ++i) n(i) = n01(rng);
   const Eigen::Matrix<double, 15, 1> d = llt.matrixL() * n;
-  init.value = estimator::boxplus(init.value, d);
+  init.value = boxplus(init.value, d);
   return init;
 }
 
@@ -41,5 +41,5 @@ uint64_t perturb_seed_for_run(uint64_t sim_seed) {
   return z == 0 ? 1 : z;
 }
 
-}  // namespace eval
+}  // namespace estimator
 }  // namespace vimot

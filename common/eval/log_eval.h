@@ -1,19 +1,18 @@
 #pragma once
-// vimot-log-eval's core: reads an LCM log (lcm-logger, vimot-sim --log),
-// decodes the estimator's nav_state_t messages and the simulator's
-// ground_truth_t messages, and evaluates the updated states against the
-// truth at the same utime with vimot_eval's metrics (TruthMatcher), so a
-// recorded LCM run and an offline run are measured identically. A message
-// that does not decode, or carries non-finite numbers, is counted and
-// skipped, never fatal.
+// vimot-log-eval's core: reads an LCM log (lcm-logger, vimot-sim --log)
+// through common/process/log_reader.h (its only LCM), and evaluates the
+// estimator's updated states against the simulator's ground truth at the
+// same utime with vimot_eval's metrics (TruthMatcher), so a recorded LCM run
+// and an offline run are measured identically. A message that does not
+// decode, or carries non-finite numbers, is counted and skipped, never fatal.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "common/eval/metrics.h"
+#include "common/eval/scale_eval.h"
 #include "common/eval/truth_matcher.h"
-#include "procs/eval/scale_eval.h"
 
 namespace vimot {
 namespace eval {

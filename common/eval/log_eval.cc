@@ -1,37 +1,15 @@
-#include "procs/eval/log_eval.h"
+#include "common/eval/log_eval.h"
 
-#include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <stdexcept>
 
 #include "common/eval/json.h"
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
-
-#include "common/process/lcm_conversions.h"
+#include "common/process/log_reader.h"
 
 namespace vimot {
 namespace eval {
-
-namespace {
-
-// Decodes a whole event as Msg; lcm-gen decoders may throw on a corrupt
-// array length instead of returning < 0: both are a malformed message.
-template <typename Msg>
-bool decode(const lcm::LogEvent& ev, Msg* msg, std::string* why) {
-  try {
-    if (msg->decode(ev.data, 0, ev.datalen) != ev.datalen) {
-      *why = "does not decode as " + std::string(Msg::getTypeName());
-      return false;
-    }
-  } catch (const std::exception& e) {
-    *why = "does not decode as " + std::string(Msg::getTypeName()) + " (" + e.what() + ")";
-    return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 int first_target_cell_index(const std::string& summary_json) {
   const JsonValue doc = JsonValue::parse(read_text_file(summary_json));
@@ -47,9 +25,7 @@ int first_target_cell_index(const std::string& summary_json) {
 }
 
 LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& options) {
-  lcm::LogFile log(path, "r");
-  if (!log.good()) throw std::runtime_error("cannot open LCM log '" + path + "'");
-
+  LogReader log(path);
   LogEvalResult r;
   TruthMatcher matcher;
   const bool scale_on = !options.scale_channel.empty();
@@ -57,47 +33,28 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   std::vector<scale::ObjectPoseInWorld> metric_poses;
   std::vector<TargetStateEstimate> object_states;
   std::map<int64_t, GroundTruth> target_truths;  // for the metric poses
-  auto malformed = [&r](int64_t* counter, const lcm::LogEvent& ev, const std::string& why) {
-    ++*counter;
-    if (r.first_malformed.empty()) {
-      r.first_malformed = "event " + std::to_string(ev.eventnum) + " on " + ev.channel + ": " + why;
-    }
-  };
-  // Decodes *ev as Msg, converts it and hands it to `use`; a message that
-  // does not decode or convert counts as malformed in *counter.
-  auto consume = [&](auto msg, const lcm::LogEvent& ev, int64_t* counter, auto use) {
-    std::string why;
-    if (!decode(ev, &msg, &why)) {
-      malformed(counter, ev, why);
-      return;
-    }
-    try {
-      use(from_lcm(msg));
-    } catch (const std::invalid_argument& e) {
-      malformed(counter, ev, e.what());
-    }
-  };
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    ++r.events;
-    if (ev->channel == options.state_channel) {
-      consume(nav_state_t{}, *ev, &r.malformed_states, [&](const NavState& x) { matcher.add_state(x); });
-    } else if (!options.target_channel.empty() && ev->channel == options.target_channel) {
-      consume(target_state_t{}, *ev, &r.malformed_targets, [&](const TargetStateEstimate& x) { matcher.add_target(x); });
-    } else if (scale_on && ev->channel == options.scale_channel) {
-      consume(scale_estimate_t{}, *ev, &r.malformed_scale, [&](const scale::ScaleResult& x) { estimates.push_back(x); });
-    } else if (scale_on && ev->channel == options.metric_channel) {
-      consume(metric_object_pose_t{}, *ev, &r.malformed_scale,
-              [&](const scale::ObjectPoseInWorld& x) { metric_poses.push_back(x); });
-    } else if (scale_on && !options.object_state_channel.empty() && ev->channel == options.object_state_channel) {
-      consume(target_state_t{}, *ev, &r.malformed_scale,
-              [&](const TargetStateEstimate& x) { object_states.push_back(x); });
-    } else if (ev->channel == options.truth_channel) {
-      consume(ground_truth_t{}, *ev, &r.malformed_truths, [&](const GroundTruth& truth) {
+  // A channel keeps its first handler: the state channel wins over the
+  // others, the truth channel is the last resort (as the channels are meant).
+  log.on_nav_state(options.state_channel, [&](const NavState& x) { matcher.add_state(x); }, &r.malformed_states);
+  log.on_target_state(options.target_channel, [&](const TargetStateEstimate& x) { matcher.add_target(x); },
+                      &r.malformed_targets);
+  if (scale_on) {
+    log.on_scale_estimate(options.scale_channel, [&](const scale::ScaleResult& x) { estimates.push_back(x); },
+                          &r.malformed_scale);
+    log.on_metric_pose(options.metric_channel, [&](const scale::ObjectPoseInWorld& x) { metric_poses.push_back(x); },
+                       &r.malformed_scale);
+    log.on_target_state(options.object_state_channel,
+                        [&](const TargetStateEstimate& x) { object_states.push_back(x); }, &r.malformed_scale);
+  }
+  log.on_ground_truth(
+      options.truth_channel,
+      [&](const GroundTruth& truth) {
         if (scale_on && truth.has_target) target_truths.emplace(truth.utime, truth);
         matcher.add_truth(truth);
-      });
-    }
-  }
+      },
+      &r.malformed_truths);
+  r.events = log.read_all();
+  r.first_malformed = log.first_malformed();
   r.samples = matcher.match(&r.counts);
   TrajectoryErrors errors;
   for (const ErrorSample& s : r.samples) errors.add(s);

@@ -1,4 +1,4 @@
-#include "procs/object_tracker/object_tracker.h"
+#include "common/object/object_tracker.h"
 
 #include <algorithm>
 #include <chrono>
@@ -99,41 +99,48 @@ Eigen::Vector3d centre_ray(const std::vector<FeatureObservation>& target, const 
 }  // namespace
 
 ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
+  config.check_keys("", {"object_tracker", "channels"});
   ObjectTrackerOptions o;
-  const std::string s = "object_tracker.";
-  o.window_size = config.get_or<int>(s + "window_size", o.window_size);
-  o.focal_length_px = config.get_or<double>(s + "focal_length_px", o.focal_length_px);
-  o.robust_loss = config.get_or<std::string>(s + "robust_loss", o.robust_loss);
-  o.robust_loss_px = config.get_or<double>(s + "robust_loss_px", o.robust_loss_px);
-  o.min_init_features = config.get_or<int>(s + "min_init_features", o.min_init_features);
-  o.min_init_parallax_deg = config.get_or<double>(s + "min_init_parallax_deg", o.min_init_parallax_deg);
-  o.init_frames = config.get_or<int>(s + "init_frames", o.init_frames);
-  o.init_min_chi2_gap = config.get_or<double>(s + "init_min_chi2_gap", o.init_min_chi2_gap);
-  o.ransac_threshold_px = config.get_or<double>(s + "ransac_threshold_px", o.ransac_threshold_px);
-  o.reference_features = config.get_or<int>(s + "reference_features", o.reference_features);
-  o.min_track_features = config.get_or<int>(s + "min_track_features", o.min_track_features);
-  o.max_reprojection_rms_px = config.get_or<double>(s + "max_reprojection_rms_px", o.max_reprojection_rms_px);
-  o.outlier_threshold_px = config.get_or<double>(s + "outlier_threshold_px", o.outlier_threshold_px);
-  o.min_feature_parallax_deg = config.get_or<double>(s + "min_feature_parallax_deg", o.min_feature_parallax_deg);
-  o.min_feature_observations = config.get_or<int>(s + "min_feature_observations", o.min_feature_observations);
-  o.max_iterations = config.get_or<int>(s + "max_iterations", o.max_iterations);
-  o.keyframe_rotation_deg = config.get_or<double>(s + "keyframe_rotation_deg", o.keyframe_rotation_deg);
-  o.keyframe_baseline = config.get_or<double>(s + "keyframe_baseline", o.keyframe_baseline);
-  o.reassociation_px = config.get_or<double>(s + "reassociation_px", o.reassociation_px);
-  if (o.window_size < 3) throw std::invalid_argument(s + "window_size must be >= 3");
-  if (!(o.focal_length_px > 0.0)) throw std::invalid_argument(s + "focal_length_px must be > 0");
-  if (o.robust_loss != "huber" && o.robust_loss != "cauchy") {
-    throw std::invalid_argument(s + "robust_loss must be huber or cauchy, got " + o.robust_loss);
-  }
-  if (o.init_frames < 2) {
-    throw std::invalid_argument(s + "init_frames must be >= 2");
-  }
-  if (!(o.reassociation_px >= 0.0)) throw std::invalid_argument(s + "reassociation_px must be >= 0");
-  if (!(o.init_min_chi2_gap >= 0.0)) throw std::invalid_argument(s + "init_min_chi2_gap must be >= 0");
-  if (o.min_init_features < 8) throw std::invalid_argument(s + "min_init_features must be >= 8");
-  if (o.reference_features < 1) throw std::invalid_argument(s + "reference_features must be >= 1");
-  if (o.min_track_features < 4) throw std::invalid_argument(s + "min_track_features must be >= 4");
-  if (o.min_feature_observations < 2) throw std::invalid_argument(s + "min_feature_observations must be >= 2");
+  if (!config.has("object_tracker")) return o;
+  config.check_keys("object_tracker",
+                    {"window_size", "focal_length_px", "robust_loss", "robust_loss_px", "min_init_features",
+                     "min_init_parallax_deg", "init_frames", "init_min_chi2_gap", "ransac_threshold_px",
+                     "reference_features", "min_track_features", "max_reprojection_rms_px", "outlier_threshold_px",
+                     "min_feature_parallax_deg", "min_feature_observations", "max_iterations",
+                     "keyframe_rotation_deg", "keyframe_baseline", "reassociation_px"});
+  const Config c = config.sub("object_tracker");
+  o.window_size = c.get_or<int>("window_size", o.window_size);
+  o.focal_length_px = c.get_or<double>("focal_length_px", o.focal_length_px);
+  o.robust_loss = c.get_or<std::string>("robust_loss", o.robust_loss);
+  o.robust_loss_px = c.get_or<double>("robust_loss_px", o.robust_loss_px);
+  o.min_init_features = c.get_or<int>("min_init_features", o.min_init_features);
+  o.min_init_parallax_deg = c.get_or<double>("min_init_parallax_deg", o.min_init_parallax_deg);
+  o.init_frames = c.get_or<int>("init_frames", o.init_frames);
+  o.init_min_chi2_gap = c.get_or<double>("init_min_chi2_gap", o.init_min_chi2_gap);
+  o.ransac_threshold_px = c.get_or<double>("ransac_threshold_px", o.ransac_threshold_px);
+  o.reference_features = c.get_or<int>("reference_features", o.reference_features);
+  o.min_track_features = c.get_or<int>("min_track_features", o.min_track_features);
+  o.max_reprojection_rms_px = c.get_or<double>("max_reprojection_rms_px", o.max_reprojection_rms_px);
+  o.outlier_threshold_px = c.get_or<double>("outlier_threshold_px", o.outlier_threshold_px);
+  o.min_feature_parallax_deg = c.get_or<double>("min_feature_parallax_deg", o.min_feature_parallax_deg);
+  o.min_feature_observations = c.get_or<int>("min_feature_observations", o.min_feature_observations);
+  o.max_iterations = c.get_or<int>("max_iterations", o.max_iterations);
+  o.keyframe_rotation_deg = c.get_or<double>("keyframe_rotation_deg", o.keyframe_rotation_deg);
+  o.keyframe_baseline = c.get_or<double>("keyframe_baseline", o.keyframe_baseline);
+  o.reassociation_px = c.get_or<double>("reassociation_px", o.reassociation_px);
+  auto require = [&c](bool ok, const std::string& key, const std::string& what) {
+    if (!ok) c.fail(key, what + ", got " + c.get<std::string>(key));
+  };
+  require(o.window_size >= 3, "window_size", "must be >= 3");
+  require(o.focal_length_px > 0.0, "focal_length_px", "must be > 0");
+  require(o.robust_loss == "huber" || o.robust_loss == "cauchy", "robust_loss", "must be huber or cauchy");
+  require(o.init_frames >= 2, "init_frames", "must be >= 2");
+  require(o.reassociation_px >= 0.0, "reassociation_px", "must be >= 0");
+  require(o.init_min_chi2_gap >= 0.0, "init_min_chi2_gap", "must be >= 0");
+  require(o.min_init_features >= 8, "min_init_features", "must be >= 8");
+  require(o.reference_features >= 1, "reference_features", "must be >= 1");
+  require(o.min_track_features >= 4, "min_track_features", "must be >= 4");
+  require(o.min_feature_observations >= 2, "min_feature_observations", "must be >= 2");
   return o;
 }
 

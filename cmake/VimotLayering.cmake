@@ -1,0 +1,30 @@
+# vimot_forbid_links(<target> <library>...): a configure error if <target>
+# links any of the libraries, directly or through other vimot libraries —
+# e.g. the live estimator processes must not carry the simulator or the
+# evaluation code. Call after every target is defined.
+function(_vimot_link_closure target out)
+  set(seen ${${out}})
+  get_target_property(type ${target} TYPE)
+  if(type STREQUAL "INTERFACE_LIBRARY")
+    get_target_property(libs ${target} INTERFACE_LINK_LIBRARIES)
+  else()
+    get_target_property(libs ${target} LINK_LIBRARIES)
+  endif()
+  foreach(lib IN LISTS libs)
+    if(TARGET ${lib} AND NOT lib IN_LIST seen)
+      list(APPEND seen ${lib})
+      _vimot_link_closure(${lib} seen)
+    endif()
+  endforeach()
+  set(${out} ${seen} PARENT_SCOPE)
+endfunction()
+
+function(vimot_forbid_links target)
+  set(closure "")
+  _vimot_link_closure(${target} closure)
+  foreach(lib IN LISTS ARGN)
+    if(lib IN_LIST closure)
+      message(FATAL_ERROR "layering: ${target} must not link ${lib} (docs/architecture.md)")
+    endif()
+  endforeach()
+endfunction()

@@ -1,0 +1,99 @@
+#include "common/process/log_reader.h"
+
+#include <lcm/lcm-cpp.hpp>
+#include <stdexcept>
+#include <utility>
+
+#include "common/process/lcm_conversions.h"
+
+namespace vimot {
+
+struct LogReader::Log {
+  explicit Log(const std::string& path) : file(path, "r") {}
+  lcm::LogFile file;
+};
+
+namespace {
+
+// Decodes a whole event as Msg; lcm-gen decoders may throw on a corrupt
+// array length instead of returning < 0: both are a malformed message.
+template <typename Msg>
+bool decode(const void* data, int size, Msg* msg, std::string* why) {
+  try {
+    if (msg->decode(data, 0, size) != size) {
+      *why = "does not decode as " + std::string(Msg::getTypeName());
+      return false;
+    }
+  } catch (const std::exception& e) {
+    *why = "does not decode as " + std::string(Msg::getTypeName()) + " (" + e.what() + ")";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+LogReader::LogReader(const std::string& path) : log_(std::make_unique<Log>(path)) {
+  if (!log_->file.good()) throw std::runtime_error("cannot open LCM log '" + path + "'");
+}
+
+LogReader::~LogReader() = default;
+
+template <typename Msg, typename Plain>
+void LogReader::subscribe(const std::string& channel, std::function<void(const Plain&)> use, int64_t* malformed) {
+  if (channel.empty()) return;
+  // Decodes as Msg, converts (from_lcm throws std::invalid_argument on
+  // non-finite numbers or bad counts) and delivers; else counts.
+  handlers_.emplace(channel, [this, use = std::move(use), malformed](const void* data, int size, int64_t eventnum,
+                                                                      const std::string& ch) {
+    Msg msg;
+    std::string why;
+    if (decode(data, size, &msg, &why)) {
+      try {
+        use(from_lcm(msg));
+        return;
+      } catch (const std::invalid_argument& e) {
+        why = e.what();
+      }
+    }
+    ++*malformed;
+    if (first_malformed_.empty()) first_malformed_ = "event " + std::to_string(eventnum) + " on " + ch + ": " + why;
+  });
+}
+
+void LogReader::on_nav_state(const std::string& channel, std::function<void(const NavState&)> use,
+                             int64_t* malformed) {
+  subscribe<nav_state_t>(channel, std::move(use), malformed);
+}
+
+void LogReader::on_ground_truth(const std::string& channel, std::function<void(const GroundTruth&)> use,
+                                int64_t* malformed) {
+  subscribe<ground_truth_t>(channel, std::move(use), malformed);
+}
+
+void LogReader::on_target_state(const std::string& channel, std::function<void(const TargetStateEstimate&)> use,
+                                int64_t* malformed) {
+  subscribe<target_state_t>(channel, std::move(use), malformed);
+}
+
+void LogReader::on_scale_estimate(const std::string& channel, std::function<void(const scale::ScaleResult&)> use,
+                                  int64_t* malformed) {
+  subscribe<scale_estimate_t>(channel, std::move(use), malformed);
+}
+
+void LogReader::on_metric_pose(const std::string& channel,
+                               std::function<void(const scale::ObjectPoseInWorld&)> use, int64_t* malformed) {
+  subscribe<metric_object_pose_t>(channel, std::move(use), malformed);
+}
+
+int64_t LogReader::read_all() {
+  int64_t events = 0;
+  while (const lcm::LogEvent* ev = log_->file.readNextEvent()) {
+    ++events;
+    const auto it = handlers_.find(ev->channel);
+    if (it != handlers_.end()) it->second(ev->data, ev->datalen, ev->eventnum, ev->channel);
+  }
+  return events;
+}
+
+}  // namespace vimot

@@ -1,0 +1,91 @@
+#include "common/target/target_filter_config.h"
+
+#include <stdexcept>
+
+namespace vimot {
+namespace target {
+
+namespace {
+
+double positive(const Config& c, const std::string& key, double fallback) {
+  const double v = c.get_or<double>(key, fallback);
+  if (!(v > 0.0)) c.fail(key, "must be > 0, got " + std::to_string(v));
+  return v;
+}
+
+double non_negative(const Config& c, const std::string& key, double fallback) {
+  const double v = c.get_or<double>(key, fallback);
+  if (!(v >= 0.0)) c.fail(key, "must be >= 0, got " + std::to_string(v));
+  return v;
+}
+
+int at_least(const Config& c, const std::string& key, int fallback, int min) {
+  const int v = c.get_or<int>(key, fallback);
+  if (v < min) c.fail(key, "must be >= " + std::to_string(min) + ", got " + std::to_string(v));
+  return v;
+}
+
+}  // namespace
+
+TargetUpdateMode parse_target_mode(const std::string& s) {
+  if (s == "skf") return TargetUpdateMode::kSkf;
+  if (s == "ekf") return TargetUpdateMode::kEkf;
+  if (s == "off") return TargetUpdateMode::kOff;
+  throw std::invalid_argument("target mode must be skf, ekf or off, got '" + s + "'");
+}
+
+TargetRepresentation parse_target_representation(const std::string& s) {
+  if (s == "local") return TargetRepresentation::kLocal;
+  if (s == "global") return TargetRepresentation::kGlobal;
+  throw std::invalid_argument("target representation must be local or global, got '" + s + "'");
+}
+
+TargetSection target_section_from_config(const Config& config) {
+  TargetSection t;
+  if (!config.has("target")) return t;
+  const Config c = config.sub("target");
+  config.check_keys("target", {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times",
+                               "init_sigmas", "points", "prediction_horizon_s"});
+  TargetFilterOptions& o = t.filter;
+  if (c.has("mode")) {
+    const std::string mode = c.get<std::string>("mode");
+    t.enabled = mode != "none";
+    try {
+      if (t.enabled) o.mode = parse_target_mode(mode);
+    } catch (const std::invalid_argument& e) {
+      c.fail("mode", std::string(e.what()) + " (or none)");
+    }
+  }
+  if (c.has("representation")) {
+    try {
+      o.representation = parse_target_representation(c.get<std::string>("representation"));
+    } catch (const std::invalid_argument& e) {
+      c.fail("representation", e.what());
+    }
+  }
+  // sigma_t 0 is a constant-velocity target (the filter accepts it).
+  o.sigma_t = non_negative(c, "sigma_t", o.sigma_t);
+  o.planar = c.get_or<bool>("planar", o.planar);
+  o.chi2_multiplier = positive(c, "chi2_multiplier", o.chi2_multiplier);
+  o.min_clone_times = at_least(c, "min_clone_times", o.min_clone_times, 2);
+  if (c.has("init_sigmas")) {
+    c.check_keys("init_sigmas", {"theta", "p", "v", "w"});
+    const Config s = c.sub("init_sigmas");
+    o.init_sigmas.theta = positive(s, "theta", o.init_sigmas.theta);
+    o.init_sigmas.p = positive(s, "p", o.init_sigmas.p);
+    o.init_sigmas.v = positive(s, "v", o.init_sigmas.v);
+    o.init_sigmas.w = positive(s, "w", o.init_sigmas.w);
+  }
+  if (c.has("points")) {
+    c.check_keys("points", {"max", "init_clone_times", "max_lost_frames"});
+    const Config p = c.sub("points");
+    o.max_target_points = at_least(p, "max", o.max_target_points, 0);
+    o.point_init_clone_times = at_least(p, "init_clone_times", o.point_init_clone_times, 2);
+    o.point_max_lost_frames = at_least(p, "max_lost_frames", o.point_max_lost_frames, 1);
+  }
+  t.prediction_horizon_s = non_negative(c, "prediction_horizon_s", t.prediction_horizon_s);
+  return t;
+}
+
+}  // namespace target
+}  // namespace vimot

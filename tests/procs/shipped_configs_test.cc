@@ -1,0 +1,157 @@
+// Every config/*.yaml loads through the one reader of the options it holds
+// (a config without a reader here fails the test), and each reader refuses
+// a misspelt key, an unknown section or a bad value with the file, the full
+// key path and the value named.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <string>
+#include <unistd.h>
+
+#include "common/config/config.h"
+#include "common/estimator/vins_config.h"
+#include "common/eval/target_eval.h"
+#include "common/object/object_tracker.h"
+#include "common/sim/sim_config.h"
+#include "procs/scale_estimator/scale_node.h"
+#include "procs/target_filter/target_filter_node.h"
+#include "procs/vins/vins_node.h"
+
+using namespace vimot;
+
+namespace {
+
+std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
+
+// The reader of each kind of shipped config, by file name prefix.
+void load_with_its_reader(const std::string& name, const std::string& path) {
+  const Config cfg = Config::load_file(path);
+  if (name == "euroc_stereo.yaml") {
+    const estimator::VioOptions o = estimator::VioOptions::from_config(cfg);
+    CHECK(o.cameras.size() == 2);
+  } else if (name == "object_tracker.yaml") {
+    CHECK(object_tracker_options_from_config(cfg).window_size == 20);
+  } else if (name == "scale_estimator.yaml") {
+    CHECK(scale_node_options_from_config(cfg).max_pending == 60);
+  } else if (name == "target_filter.yaml") {
+    const TargetFilterNodeOptions o = node_options_from_config(cfg);
+    CHECK(o.target_enabled);
+    CHECK(o.target.sigma_t == eval::target_filter_options(cfg).sigma_t);
+  } else if (name.rfind("vins", 0) == 0) {
+    const VinsNodeOptions o = vins_node_options_from_config(cfg);
+    CHECK(o.vio.state.max_clones == estimator::load_vio_options(path).state.max_clones);
+  } else if (name.rfind("sim_", 0) == 0) {
+    if (name == "sim_trajectory.yaml" && std::getenv("VIMOT_DATA_DIR") == nullptr) {
+      // Its trajectory file is in the shared data: without it, that is the error.
+      CHECK_THROWS_WITH(sim::from_config(cfg), Catch::Contains("VIMOT_DATA_DIR"));
+    } else {
+      CHECK_NOTHROW(sim::from_config(cfg));
+    }
+  } else {
+    FAIL("no reader known for config/" << name << ": add it to this test");
+  }
+}
+
+// A config file in a fresh folder beside copies of the files the shipped
+// configs name (calibration_file, vins_config), so those resolve.
+struct TempFile {
+  explicit TempFile(const std::string& text) {
+    char tmpl[] = "/tmp/vimot_configs_XXXXXX";
+    dir = mkdtemp(tmpl);
+    for (const char* name : {"euroc_stereo.yaml", "vins.yaml"}) {
+      std::filesystem::copy_file(source_path("config/") + name, dir + "/" + name);
+    }
+    path = dir + "/edited.yaml";
+    std::ofstream(path) << text;
+  }
+  ~TempFile() { std::filesystem::remove_all(dir); }
+  std::string dir;
+  std::string path;
+};
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "<no exception>";
+}
+
+std::string text_of(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+}  // namespace
+
+TEST_CASE("every shipped config loads through its reader", "[config]") {
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(source_path("config"))) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".yaml" || name[0] == '.') continue;
+    ++files;
+    INFO("config/" << name);
+    try {
+      load_with_its_reader(name, entry.path().string());
+    } catch (const std::exception& e) {
+      FAIL(e.what());
+    }
+  }
+  CHECK(files >= 13);
+}
+
+TEST_CASE("misspelt keys, unknown sections and bad values name file, key path and value", "[config]") {
+  const std::string vins = text_of(source_path("config/vins.yaml"));
+  const std::string target = text_of(source_path("config/target_filter.yaml"));
+  // Each case: a shipped config with one edit, the reader, the expected words.
+  struct Case {
+    std::string text;
+    std::function<void(const Config&)> read;
+    std::string expected;
+  };
+  const auto read_vins = [](const Config& c) { vins_node_options_from_config(c); };
+  const auto read_target = [](const Config& c) { node_options_from_config(c); };
+  const std::vector<Case> cases = {
+      {vins + "\nestimator_extra: 1\n", read_vins, "key 'estimator_extra' (value '1') is unknown"},
+      {std::string(vins).replace(vins.find("  num_clones:"), 13, "  num_clonez:"), read_vins,
+       "key 'estimator.num_clonez' (value '11') is unknown"},
+      {std::string(vins).replace(vins.find("channels:"), 9, "channelz:"), read_vins,
+       "key 'channelz' (value '{imu: IMU"},
+      {std::string(vins).replace(vins.find("  perturb_seed:"), 15, "  perturb_sead:"), read_vins,
+       "key 'init.perturb_sead' (value '1') is unknown"},
+      {vins + "\noutput: {imu_rates: true}\n", read_vins, "key 'output.imu_rates' (value 'true')"},
+      {std::string(target).replace(target.find("  sigma_t:"), 10, "  sigma_tt:"), read_target,
+       "key 'target.sigma_tt' (value '0.05') is unknown"},
+      {std::string(target).replace(target.find("  sigma_t: 0.05"), 15, "  sigma_t: -1"), read_target,
+       "key 'target.sigma_t' must be >= 0, got -1"},
+      {std::string(target).replace(target.find("    max: 25"), 11, "    maxx: 25"), read_target,
+       "key 'target.points.maxx' (value '25')"},
+      {target + "\nestimator: {num_clones: 3}\n", read_target, "key 'estimator' (value '{num_clones: 3}')"},
+      {"scenario: paper\ncalibration_file: euroc_stereo.yaml\ncamera: {rate_hz: 20, rate_hz: 10}\n",
+       [](const Config& c) { sim::from_config(c); }, "key 'camera.rate_hz' is repeated (line 3, value '10')"},
+      {"object_tracker: {window_size: 20}\nchannels: {}\nobjekt_filter: {}\n",
+       [](const Config& c) { object_tracker_options_from_config(c); }, "key 'objekt_filter' (value '{}')"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    TempFile file(c.text);
+    const std::string msg = error_of([&] { c.read(Config::load_file(file.path)); });
+    INFO("case " << i << ": " << msg);
+    CHECK(msg.find(file.path) != std::string::npos);
+    CHECK(msg.find(c.expected) != std::string::npos);
+  }
+}
+
+TEST_CASE("a directory or an empty file as a process config says so", "[config]") {
+  const std::string dir = error_of([] { vins_node_options_from_config(Config::load_file(source_path("config"))); });
+  CHECK(dir.find("is a directory") != std::string::npos);
+  TempFile empty("\n# nothing\n");
+  const std::string msg = error_of([&] { vins_node_options_from_config(Config::load_file(empty.path)); });
+  CHECK(msg.find("is empty") != std::string::npos);
+  CHECK(msg.find("cameras.cam0") == std::string::npos);
+}
