@@ -100,6 +100,9 @@ bool IsSimpleCommand(const std::string& command) {
       if (c == '"') quote = 0;
     } else if (c == '\'' || c == '"') {
       quote = c;
+    } else if (c == '&' && i > 0 && (command[i - 1] == '>' || command[i - 1] == '<')) {
+      // A redirection (2>&1, <&3), not a control operator. (`&>file` is
+      // bash; /bin/sh reads it as `&` then `>file`.)
     } else if (std::strchr(";&|()\n", c) != nullptr) {
       return false;  // a list, pipeline, background job or subshell
     }

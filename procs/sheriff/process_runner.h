@@ -106,7 +106,8 @@ struct RunnerOptions {
 };
 
 /// The line given to `/bin/sh -c` for `command`: "exec <command>" when it is
-/// one simple command (no ; & | ( ) or newline outside quotes, not starting
+/// one simple command (no ; & | ( ) or newline outside quotes, other than
+/// the & of a redirection such as 2>&1; not starting
 /// with an assignment, a reserved word or a shell builtin), so the program
 /// replaces the shell: the pid, exit status and parent-death signal are then
 /// the program's own. Anything else is left to the shell as written.

@@ -24,6 +24,11 @@ TEST_CASE("one simple command is exec'd by the shell; lists, pipelines and built
   CHECK(ShellCommandLine("a | b") == "a | b");
   CHECK(ShellCommandLine("a && b") == "a && b");
   CHECK(ShellCommandLine("a &") == "a &");
+  CHECK(ShellCommandLine("prog 2>&1") == "exec prog 2>&1");
+  CHECK(ShellCommandLine("prog <&3") == "exec prog <&3");
+  CHECK(ShellCommandLine("prog &>log") == "prog &>log");
+  CHECK(ShellCommandLine("a & b") == "a & b");
+  CHECK(ShellCommandLine("a&&b") == "a&&b");
   CHECK(ShellCommandLine("(a)") == "(a)");
   CHECK(ShellCommandLine("a\nb") == "a\nb");
   CHECK(ShellCommandLine("X=1 prog") == "X=1 prog");
