@@ -491,6 +491,7 @@ void ProcessRunner::StopAll() {
   for (std::size_t i = 0; i < records_.size(); ++i) {
     Record& r = records_[i];
     r.restart_pending = false;
+    r.ending_on_its_own = false;  // stopped now, never respawned
     if (r.state.status == CommandStatus::kRespawnPending) StopRecord(&r);
     if (IsAlive(r)) alive.push_back(i);
   }
@@ -504,6 +505,7 @@ void ProcessRunner::StopAll() {
 void ProcessRunner::KillAll() {
   for (Record& r : records_) {
     r.restart_pending = false;
+    r.ending_on_its_own = false;
     if (r.state.status == CommandStatus::kRespawnPending) StopRecord(&r);
     if (!IsAlive(r)) continue;
     ::kill(-r.pgid, SIGKILL);

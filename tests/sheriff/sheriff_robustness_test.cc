@@ -117,6 +117,29 @@ TEST_CASE("a command whose shell was killed, without respawn, counts as exited o
   CHECK(runner.IsIdle());
 }
 
+TEST_CASE("StopAll while a killed shell's group is being stopped ends it as stopped, not respawned") {
+  Recorder rec;
+  RunnerOptions options = rec.Options();
+  options.respawn_backoff_initial = milliseconds(50);
+  // The program ignores the stop signal, so its group outlives the shell
+  // until SIGKILL.
+  CommandSpec spec = Command("stubborn", "sh -c 'trap \"\" TERM; echo ready; while :; do sleep 0.05; done'; true");
+  spec.auto_respawn = true;
+  spec.stop_time_allowed = milliseconds(1000);
+  ProcessRunner runner({spec}, options);
+  runner.Start("stubborn");
+  const pid_t group = runner.state("stubborn").pid;
+  REQUIRE(PollUntil(&runner, [&] { return rec.HasOutput("[stubborn] ready"); }));
+  REQUIRE(::kill(group, SIGKILL) == 0);
+  REQUIRE(PollUntil(&runner, [&] { return rec.EventIndex("left processes in its group") >= 0; }));
+  runner.StopAll();
+  REQUIRE(PollUntil(&runner, [&] { return runner.IsIdle(); }));
+  INFO(rec.AllEvents());
+  CHECK(runner.state("stubborn").status == CommandStatus::kStopped);
+  CHECK(runner.state("stubborn").start_count == 1);
+  CHECK(LiveGroupMembers(group) == 0);
+}
+
 namespace {
 ConfigParseError ParseError(const std::string& text) {
   try {
