@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -186,7 +187,8 @@ TEST_CASE("a subscriber counts the oversized FEATURES as a decode error and neve
 }
 
 TEST_CASE("vimot-log-summary counts the oversized FEATURES as undecodable instead of dying") {
-  const std::string log_path = std::filesystem::temp_directory_path() / "lcm_layout_test_huge_features.lcmlog";
+  const std::string log_path = std::filesystem::temp_directory_path() /
+                               ("lcm_layout_test_" + std::to_string(::getpid()) + ".lcmlog");
   {
     lcm::LogFile log(log_path, "w");
     REQUIRE(log.good());
