@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "common/process/lcm_conversions.h"
+#include "common/process/lcm_type_registry.h"
 
 namespace vimot {
 
@@ -13,25 +14,6 @@ struct LogReader::Log {
   lcm::LogFile file;
 };
 
-namespace {
-
-// Decodes a whole event as Msg; lcm-gen decoders may throw on a corrupt
-// array length instead of returning < 0: both are a malformed message.
-template <typename Msg>
-bool decode(const void* data, int size, Msg* msg, std::string* why) {
-  try {
-    if (msg->decode(data, 0, size) != size) {
-      *why = "does not decode as " + std::string(Msg::getTypeName());
-      return false;
-    }
-  } catch (const std::exception& e) {
-    *why = "does not decode as " + std::string(Msg::getTypeName()) + " (" + e.what() + ")";
-    return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 LogReader::LogReader(const std::string& path) : log_(std::make_unique<Log>(path)) {
   if (!log_->file.good()) throw std::runtime_error("cannot open LCM log '" + path + "'");
@@ -47,8 +29,8 @@ void LogReader::subscribe(const std::string& channel, std::function<void(const P
   handlers_.emplace(channel, [this, use = std::move(use), malformed](const void* data, int size, int64_t eventnum,
                                                                       const std::string& ch) {
     Msg msg;
-    std::string why;
-    if (decode(data, size, &msg, &why)) {
+    std::string why = "does not decode as " + std::string(Msg::getTypeName());
+    if (decode_untrusted(data, size, &msg)) {
       try {
         use(from_lcm(msg));
         return;

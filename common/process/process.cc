@@ -24,10 +24,6 @@ void install_signal_handlers() {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 }
-
-// Decode errors are logged for the first few, then only counted, so a
-// stream of garbage cannot flood the log.
-constexpr int64_t kMaxDecodeErrorsLogged = 10;
 }  // namespace
 
 Process::Process(std::string name, std::string summary, bool config_required)
@@ -74,11 +70,8 @@ void Process::handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& chan
   }
   if (!decoded) {
     ++counters_.decode_errors;
-    if (++decode_errors_logged_ <= kMaxDecodeErrorsLogged) {
-      log_warn("cannot decode a ", rbuf->data_size, "-byte message on ", channel,
-               " (wrong type or corrupt); dropped",
-               decode_errors_logged_ == kMaxDecodeErrorsLogged ? " — further decode errors only counted" : "");
-    }
+    log_warn("cannot decode a ", rbuf->data_size, "-byte message on ", channel,
+             " (wrong type, corrupt, or a length longer than the message); dropped");
   }
 }
 
@@ -123,9 +116,11 @@ int Process::run(const std::function<void()>& idle) {
     if (idle) idle();
     if (Clock::now() >= next_heartbeat) {
       publish_heartbeat();
+      flush_suppressed_logs();
       next_heartbeat += std::chrono::seconds(1);
     }
   }
+  flush_suppressed_logs();
   log_info("stopping: in ", counters_.messages_in.load(), ", out ", counters_.messages_out.load(),
            ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(),
            ", errors ", counters_.errors.load());

@@ -22,6 +22,7 @@
 
 #include "common/config/config.h"
 #include "common/process/arg_parser.h"
+#include "common/process/lcm_type_registry.h"
 #include "common/process/logger.h"
 
 namespace vimot {
@@ -59,8 +60,9 @@ class Process {
   /// A channel name from config key `channels.<role>`, `fallback` if absent.
   std::string channel(const std::string& role, const std::string& fallback) const;
 
-  /// Subscribes with decoding done here, so a malformed message is counted
-  /// as a decode error and logged (rate-limited), never a crash.
+  /// Subscribes with decoding done here (decode_untrusted: lengths checked
+  /// before anything is allocated), so a malformed message is counted as a
+  /// decode error and logged (rate-limited), never a crash.
   template <typename Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> handler);
 
@@ -98,7 +100,6 @@ class Process {
   std::unique_ptr<lcm::LCM> lcm_;
   ProcessCounters counters_;
   std::string last_error_;
-  int64_t decode_errors_logged_{0};
   std::atomic<bool> stop_requested_{false};
 
   // Subscriptions keep their closures alive for the LCM callbacks.
@@ -117,13 +118,7 @@ void Process::subscribe(const std::string& channel, std::function<void(const Msg
   sub->channel = channel;
   sub->decode_and_call = [handler = std::move(handler)](const void* data, int size) {
     Msg msg;
-    // lcm-gen 1.3 decoders throw (length_error, bad_alloc) on a corrupt array
-    // length instead of returning < 0: both are a malformed message.
-    try {
-      if (msg.decode(data, 0, size) != size) return false;
-    } catch (const std::exception&) {
-      return false;
-    }
+    if (!decode_untrusted(data, size, &msg)) return false;
     handler(msg);  // exceptions here are the handler's: counted as errors
     return true;
   };

@@ -72,7 +72,60 @@ std::vector<std::string> DefaultLocalHostNames() {
   return names;
 }
 
+// Words the shell must see first: reserved words and builtins that exist as
+// no program, so "exec <word> ..." would fail or mean something else.
+bool IsShellWord(const std::string& word) {
+  static const char* const kWords[] = {
+      "if", "then", "else", "elif", "fi", "for", "while", "until", "do", "done", "case", "esac", "{", "}",
+      "!", "[[", "exec", "cd", "export", "set", "unset", "eval", "trap", ".", "source", "readonly", "shift",
+      "wait", "alias", "unalias", "umask", "ulimit", "read", "local", "return", "exit", "break", "continue",
+      "times", "type", "command", "hash", "getopts", "jobs", "fg", "bg", "function", "time"};
+  for (const char* w : kWords) {
+    if (word == w) return true;
+  }
+  return false;
+}
+
+bool IsSimpleCommand(const std::string& command) {
+  char quote = 0;
+  std::string first_word;
+  bool in_first_word = false, first_word_done = false;
+  for (std::size_t i = 0; i < command.size(); ++i) {
+    const char c = command[i];
+    if (quote == '\'') {
+      if (c == '\'') quote = 0;
+    } else if (c == '\\') {
+      ++i;  // the escaped character is literal
+    } else if (quote == '"') {
+      if (c == '"') quote = 0;
+    } else if (c == '\'' || c == '"') {
+      quote = c;
+    } else if (c == '&' && i > 0 && (command[i - 1] == '>' || command[i - 1] == '<')) {
+      // A redirection (2>&1, <&3), not a control operator. (`&>file` is
+      // bash; /bin/sh reads it as `&` then `>file`.)
+    } else if (std::strchr(";&|()\n", c) != nullptr) {
+      return false;  // a list, pipeline, background job or subshell
+    }
+    // The first word, as written (quotes make it a program name anyway).
+    const bool space = quote == 0 && (c == ' ' || c == '\t');
+    if (!first_word_done) {
+      if (!space) {
+        in_first_word = true;
+        first_word.push_back(c);
+        if (quote == 0 && c == '=') return false;  // VAR=value prefix
+      } else if (in_first_word) {
+        first_word_done = true;
+      }
+    }
+  }
+  return quote == 0 && !first_word.empty() && !IsShellWord(first_word);
+}
+
 }  // namespace
+
+std::string ShellCommandLine(const std::string& command) {
+  return IsSimpleCommand(command) ? "exec " + command : command;
+}
 
 const char* ToString(CommandStatus status) {
   switch (status) {
@@ -291,6 +344,14 @@ void ProcessRunner::StartRecord(Record* r, bool is_respawn) {
   // Output still buffered from the previous run belongs before the new run's.
   FlushPipes(r);
 
+  if (!watchdog_) {
+    try {
+      watchdog_.emplace();
+    } catch (const std::exception& e) {
+      Emit(std::string("no watchdog (commands would outlive a killed sheriff): ") + e.what());
+    }
+  }
+
   int out_fds[2] = {-1, -1};
   int err_fds[2] = {-1, -1};
   // O_CLOEXEC: no child may inherit another child's pipe ends, or EOF would
@@ -320,8 +381,10 @@ void ProcessRunner::StartRecord(Record* r, bool is_respawn) {
   std::vector<char*> envp;
   for (std::string& s : env_strings) envp.push_back(s.data());
   envp.push_back(nullptr);
-  std::string sh = "/bin/sh", dash_c = "-c";
-  std::vector<char*> argv = {sh.data(), dash_c.data(), command.data(), nullptr};
+  std::string sh = "/bin/sh", dash_c = "-c", line = ShellCommandLine(command);
+  std::vector<char*> argv = {sh.data(), dash_c.data(), line.data(), nullptr};
+  const pid_t sheriff_pid = ::getpid();
+  const int death_signal = r->spec.stop_signal;
   const char exec_failed[] = "vimot-sheriff: cannot exec /bin/sh\n";
 
   // All signals stay blocked across fork() until the child has reset their
@@ -333,6 +396,11 @@ void ProcessRunner::StartRecord(Record* r, bool is_respawn) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::setpgid(0, 0);
+    // Die with the sheriff (the program itself when the shell exec's it);
+    // the watchdog covers the rest of the group. If the sheriff died before
+    // the prctl, the parent is already someone else.
+    ::prctl(PR_SET_PDEATHSIG, death_signal);
+    if (::getppid() != sheriff_pid) ::_exit(127);
     // Handlers would be reset by exec, but "ignore" would survive it: start
     // the command with default dispositions whatever the sheriff ignores
     // (SIGPIPE) or handles.
@@ -383,11 +451,13 @@ void ProcessRunner::StartRecord(Record* r, bool is_respawn) {
     if (other.pgid == pid) other.pgid = 0;
   }
   r->pgid = pid;
+  if (watchdog_) watchdog_->Watch(pid, r->spec.stop_signal, r->spec.stop_time_allowed);
   r->start_sequence = next_start_sequence_++;
   r->started_at = Clock::now();
   r->leader_reaped = false;
   r->kill_sent = false;
   r->restart_pending = false;
+  r->ending_on_its_own = false;
   Emit((is_respawn ? "respawned '" : "started '") + name + "' (pid " +
        std::to_string(pid) + "): " + command);
 }
@@ -397,6 +467,11 @@ void ProcessRunner::StopRecord(Record* r) {
   if (r->state.status == CommandStatus::kRespawnPending) {
     r->state.status = CommandStatus::kStopped;
     Emit("cancelled the respawn of '" + r->spec.name + "'");
+    return;
+  }
+  if (r->state.status == CommandStatus::kStopping && r->ending_on_its_own) {
+    // Already being stopped; now it ends as stopped, not as exited.
+    r->ending_on_its_own = false;
     return;
   }
   if (r->state.status != CommandStatus::kRunning) return;
@@ -416,6 +491,7 @@ void ProcessRunner::StopAll() {
   for (std::size_t i = 0; i < records_.size(); ++i) {
     Record& r = records_[i];
     r.restart_pending = false;
+    r.ending_on_its_own = false;  // stopped now, never respawned
     if (r.state.status == CommandStatus::kRespawnPending) StopRecord(&r);
     if (IsAlive(r)) alive.push_back(i);
   }
@@ -429,6 +505,7 @@ void ProcessRunner::StopAll() {
 void ProcessRunner::KillAll() {
   for (Record& r : records_) {
     r.restart_pending = false;
+    r.ending_on_its_own = false;
     if (r.state.status == CommandStatus::kRespawnPending) StopRecord(&r);
     if (!IsAlive(r)) continue;
     ::kill(-r.pgid, SIGKILL);
@@ -473,7 +550,31 @@ void ProcessRunner::OnLeaderExit(Record* r, int wait_status,
     return;
   }
   r->state.pid = -1;
-  const auto ran = std::chrono::duration_cast<milliseconds>(now - r->started_at);
+  r->leader_exit_at = now;
+  // Zombies of the group are not "left running".
+  int ignored = 0;
+  while (::waitpid(-r->pgid, &ignored, WNOHANG) > 0) {
+  }
+  if (GroupExists(r->pgid)) {
+    // E.g. the shell of a pipeline was killed: what it started must not run
+    // on beside a respawned copy, nor outlive the sheriff unwatched.
+    r->ending_on_its_own = true;
+    r->state.status = CommandStatus::kStopping;
+    ::kill(-r->pgid, r->spec.stop_signal);
+    r->kill_sent = false;
+    r->kill_at = now + r->spec.stop_time_allowed;
+    Emit("'" + r->spec.name + "' (pid " + std::to_string(r->pgid) + ") ended with " + info.ToString() +
+         " but left processes in its group; stopping them with " + SignalName(r->spec.stop_signal) +
+         " (SIGKILL after " + Seconds(r->spec.stop_time_allowed) + ")");
+    return;
+  }
+  FinishExit(r);
+}
+
+void ProcessRunner::FinishExit(Record* r) {
+  r->ending_on_its_own = false;
+  const ExitInfo info = r->state.last_exit.value_or(ExitInfo{});
+  const auto ran = std::chrono::duration_cast<milliseconds>(r->leader_exit_at - r->started_at);
   if (!r->spec.auto_respawn) {
     r->state.status = CommandStatus::kExited;
     Emit("'" + r->spec.name + "' exited with " + info.ToString() + " after " +
@@ -486,11 +587,16 @@ void ProcessRunner::OnLeaderExit(Record* r, int wait_status,
   }
   const milliseconds delay = r->backoff;
   r->backoff = std::min(delay * 2, options_.respawn_backoff_max);
-  r->respawn_at = now + delay;
+  r->respawn_at = std::max(Clock::now(), r->leader_exit_at + delay);
   r->state.status = CommandStatus::kRespawnPending;
   Emit("'" + r->spec.name + "' exited with " + info.ToString() + " after " +
        Seconds(ran) + "; respawning in " + Seconds(delay) + " (respawn #" +
        std::to_string(r->state.respawn_count + 1) + ")");
+}
+
+void ProcessRunner::ForgetGroup(Record* r) {
+  if (watchdog_ && r->pgid > 0) watchdog_->Forget(r->pgid);
+  r->pgid = 0;
 }
 
 void ProcessRunner::ReapGroup(Record* r, Clock::time_point now) {
@@ -516,14 +622,23 @@ void ProcessRunner::ReapGroup(Record* r, Clock::time_point now) {
   }
   // Forget a group that is gone, so a later process that happens to reuse
   // the id is never mistaken for (and reaped as) a member of this command.
-  if (!IsAlive(*r) && !group_exists) r->pgid = 0;
+  if (!IsAlive(*r) && !group_exists) ForgetGroup(r);
 }
 
 void ProcessRunner::FinishStop(Record* r) {
-  r->state.status = CommandStatus::kStopped;
   r->state.pid = -1;
-  Emit("'" + r->spec.name + "' stopped; it ended with " +
-       (r->state.last_exit ? r->state.last_exit->ToString() : "unknown status"));
+  if (r->ending_on_its_own) {
+    FinishExit(r);
+    return;
+  }
+  r->state.status = CommandStatus::kStopped;
+  std::string how = "unknown status";
+  if (const std::optional<ExitInfo>& e = r->state.last_exit) {
+    how = e->signal == r->spec.stop_signal ? SignalName(e->signal) + ", its stop signal, as asked"
+          : e->signal == SIGKILL && r->kill_sent ? "SIGKILL after stop_time_allowed"
+                                                 : e->ToString();
+  }
+  Emit("'" + r->spec.name + "' stopped; it ended with " + how);
   if (r->restart_pending) {
     r->restart_pending = false;
     StartRecord(r, false);
@@ -616,6 +731,9 @@ void ProcessRunner::Poll(milliseconds max_wait) {
   now = Clock::now();
   for (Record& r : records_) ReapGroup(&r, now);
   AdvanceStopAll();
+  if (watchdog_ && watchdog_->Check()) {
+    Emit("the watchdog process had ended; started a new one (pid " + std::to_string(watchdog_->pid()) + ")");
+  }
 }
 
 }  // namespace vimot::sheriff

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "procs/sheriff/group_watchdog.h"
 #include "procs/sheriff/line_splitter.h"
 #include "procs/sheriff/sheriff_config.h"
 #include "procs/sheriff/unique_fd.h"
@@ -104,9 +105,18 @@ struct RunnerOptions {
   std::function<void(const std::string& message)> on_event;
 };
 
+/// The line given to `/bin/sh -c` for `command`: "exec <command>" when it is
+/// one simple command (no ; & | ( ) or newline outside quotes, other than
+/// the & of a redirection such as 2>&1; not starting
+/// with an assignment, a reserved word or a shell builtin), so the program
+/// replaces the shell: the pid, exit status and parent-death signal are then
+/// the program's own. Anything else is left to the shell as written.
+std::string ShellCommandLine(const std::string& command);
+
 /// Starts, watches, respawns and stops the commands of a config.
 ///
-/// Each command runs as `/bin/sh -c "<exec>"` in its own process group, so
+/// Each command runs as `/bin/sh -c "<exec>"` (see ShellCommandLine) in its
+/// own process group, so
 /// the stop signal reaches everything the shell started, and so a Ctrl-C in
 /// the sheriff's terminal reaches only the sheriff, which then stops the
 /// commands in order. stdout and stderr are read through non-blocking pipes
@@ -116,6 +126,13 @@ struct RunnerOptions {
 /// every state change happens inside Poll() or the command methods. A respawn
 /// is never started in the same Poll() call that saw the exit, so a caller
 /// that inspects state() after each Poll() can still cancel it with Stop().
+///
+/// A command's process group is never lost: when its main process ends on
+/// its own (or is killed) while other members of the group still run, they
+/// are stopped like a command (stop_signal, SIGKILL after stop_time_allowed)
+/// before the command counts as exited or is respawned. The commands die
+/// with the runner's process, even by SIGKILL: each child gets
+/// PR_SET_PDEATHSIG (its stop_signal) and a GroupWatchdog stops every group.
 class ProcessRunner {
  public:
   /// Throws std::invalid_argument on duplicate or empty command names and on
@@ -200,6 +217,10 @@ class ProcessRunner {
     Clock::time_point respawn_at{};
     std::chrono::milliseconds backoff{0};
     bool restart_pending{false};
+    /// The main process ended on its own and the rest of its group is being
+    /// stopped (kStopping); then it counts as exited or is respawned.
+    bool ending_on_its_own{false};
+    Clock::time_point leader_exit_at{};
     /// Pipes of the latest run; kept open after the process ends until EOF,
     /// so output written just before exit is not lost.
     std::vector<OutputPipe> pipes;
@@ -214,6 +235,10 @@ class ProcessRunner {
   void ReapGroup(Record* r, Clock::time_point now);
   void OnLeaderExit(Record* r, int wait_status, Clock::time_point now);
   void FinishStop(Record* r);
+  /// Exited (or respawn pending) after the main process ended on its own.
+  void FinishExit(Record* r);
+  /// The group has ended: forget its id here and in the watchdog.
+  void ForgetGroup(Record* r);
   void ReadPipe(Record* r, OutputPipe* pipe);
   void FlushPipes(Record* r);
   void AdvanceStopAll();
@@ -227,6 +252,8 @@ class ProcessRunner {
   std::size_t next_start_sequence_{1};
   /// Indices still to be stopped by StopAll(), next first.
   std::vector<std::size_t> stop_queue_;
+  /// Created with the first command started.
+  std::optional<GroupWatchdog> watchdog_;
 };
 
 }  // namespace vimot::sheriff

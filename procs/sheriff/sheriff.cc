@@ -109,6 +109,9 @@ void Sheriff::CheckExitWhen() {
     return;
   }
   if (state.exit_count <= exit_when_seen_ || !state.last_exit) return;
+  // Still stopping what the main process left in its group: look again
+  // once the command has exited, been stopped or is due to respawn.
+  if (state.status == CommandStatus::kStopping) return;
   exit_when_seen_ = state.exit_count;
   const ExitInfo exit = *state.last_exit;
   const bool clean = exit.signal == 0 && exit.exit_code == 0;

@@ -1,5 +1,6 @@
 #include "procs/sheriff/sheriff_config.h"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -140,6 +141,11 @@ std::string SheriffConfig::NormalizeGroupName(const std::string& name) {
   return out;
 }
 
+int SheriffConfig::GroupDepth(const std::string& normalized_name) {
+  if (normalized_name.empty()) return 0;
+  return 1 + static_cast<int>(std::count(normalized_name.begin(), normalized_name.end(), '/'));
+}
+
 void SheriffConfig::AddCommand(CommandSpec command) {
   if (command.name.empty()) {
     throw std::invalid_argument("SheriffConfig: a command needs a name");
@@ -165,6 +171,11 @@ void SheriffConfig::AddGroup(const std::string& full_name,
                                 full_name + "'");
   }
   if (group_index_.count(name) > 0) return;
+  if (GroupDepth(name) > kMaxGroupDepth) {
+    throw std::invalid_argument("SheriffConfig: group '" + name.substr(0, 60) + "...' nests " +
+                                std::to_string(GroupDepth(name)) + " levels deep; at most " +
+                                std::to_string(kMaxGroupDepth) + " are allowed");
+  }
   const std::size_t slash = name.rfind('/');
   if (slash != std::string::npos) {
     const std::string parent = name.substr(0, slash);

@@ -25,6 +25,11 @@ struct SourceLocation {
 /// procman's defaults: SIGINT (2), which most programs treat as "shut down
 /// cleanly", and 7 s before the sheriff gives up and sends SIGKILL.
 constexpr int kDefaultStopSignal = 2;
+/// Limits that keep a hostile or generated config from exhausting the stack
+/// or memory (a group path is stored per level, so depth costs depth^2):
+/// groups nest at most this deep, and run_script chains at most this long.
+constexpr int kMaxGroupDepth = 32;
+constexpr int kMaxScriptNesting = 64;
 constexpr std::chrono::milliseconds kDefaultStopTimeAllowed{7000};
 
 /// One `cmd "name" { ... }` block.
@@ -114,7 +119,8 @@ class SheriffConfig {
   void AddCommand(CommandSpec command);
   /// Creates the group `full_name` and its parents if they do not exist yet
   /// (a group may be opened more than once; the blocks merge). Throws
-  /// std::invalid_argument on an empty path component.
+  /// std::invalid_argument on an empty path or one deeper than
+  /// kMaxGroupDepth.
   void AddGroup(const std::string& full_name, const SourceLocation& location);
   /// Throws std::invalid_argument if the name is empty or already used.
   void AddScript(ScriptSpec script);
@@ -139,6 +145,8 @@ class SheriffConfig {
 
   /// Normalises a group path: no leading, trailing or doubled '/'.
   static std::string NormalizeGroupName(const std::string& name);
+  /// Levels of a normalised group path ("a/b" = 2).
+  static int GroupDepth(const std::string& normalized_name);
 
  private:
   std::vector<CommandSpec> commands_;

@@ -1,9 +1,11 @@
 #include "procs/sheriff/sheriff_config_parser.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -312,6 +314,11 @@ class Parser {
     }
     if (blank) Fail(name, "expected a non-empty group name");
     const std::string full = parent.empty() ? name.text : parent + "/" + name.text;
+    // Checked before descending: each level is a recursive call.
+    if (SheriffConfig::GroupDepth(SheriffConfig::NormalizeGroupName(full)) > kMaxGroupDepth) {
+      Fail(name, "groups nest more than " + std::to_string(kMaxGroupDepth) +
+                     " levels deep (group \"" + name.text + "\")");
+    }
     config_.AddGroup(full, Location(name));
     Expect(TokenType::kOpenBrace, "'{' after group \"" + name.text + "\"");
     while (true) {
@@ -414,6 +421,10 @@ class Parser {
         cmd.stop_time_allowed = std::chrono::seconds(seconds);
       } else if (key.text == "group") {
         const std::string group = SheriffConfig::NormalizeGroupName(value.text);
+        if (SheriffConfig::GroupDepth(group) > kMaxGroupDepth) {
+          Fail(value, "group path of cmd \"" + cmd.name + "\" nests more than " +
+                          std::to_string(kMaxGroupDepth) + " levels deep");
+        }
         if (!enclosing_group.empty() && group != enclosing_group) {
           Fail(value, "cmd \"" + cmd.name + "\" is inside group \"" +
                           enclosing_group + "\" but says group = \"" +
@@ -561,37 +572,58 @@ class Parser {
         }
       }
     }
-    // run_script must not recurse: the sheriff would never finish.
-    std::map<std::string, int> state;  // 0 unvisited, 1 on stack, 2 done.
-    std::vector<std::string> path;
+    // run_script must not recurse (the sheriff would never finish) nor nest
+    // without bound. Depth-first over an explicit stack: a generated chain
+    // of 40 000 scripts must not overflow the parser's own stack.
+    std::map<std::string, int> height;  // longest run_script chain; -1 on the path
     for (const ScriptSpec& script : config_.scripts()) {
-      CheckNoCycle(script, &state, &path);
+      if (height.count(script.name) == 0) CheckRunScripts(script, &height);
     }
   }
 
-  void CheckNoCycle(const ScriptSpec& script, std::map<std::string, int>* state,
-                    std::vector<std::string>* path) const {
-    int& mark = (*state)[script.name];
-    if (mark == 2) return;
-    mark = 1;
-    path->push_back(script.name);
-    for (const ScriptAction& action : script.actions) {
+  void CheckRunScripts(const ScriptSpec& root, std::map<std::string, int>* height) const {
+    struct Frame {
+      const ScriptSpec* script;
+      std::size_t next_action;
+      int max_child_height;
+    };
+    std::vector<Frame> path{{&root, 0, 0}};
+    (*height)[root.name] = -1;
+    while (!path.empty()) {
+      Frame& top = path.back();
+      if (top.next_action == top.script->actions.size()) {
+        const int h = top.max_child_height + 1;
+        if (h > kMaxScriptNesting) {
+          Fail(top.script->location, "run_script nests scripts more than " +
+                                         std::to_string(kMaxScriptNesting) + " deep, starting at script \"" +
+                                         top.script->name + "\"");
+        }
+        (*height)[top.script->name] = h;
+        path.pop_back();
+        if (!path.empty()) path.back().max_child_height = std::max(path.back().max_child_height, h);
+        continue;
+      }
+      const ScriptAction& action = top.script->actions[top.next_action++];
       if (action.kind != ActionKind::kRunScript) continue;
-      if ((*state)[action.name] == 1) {
+      const auto known = height->find(action.name);
+      if (known != height->end() && known->second > 0) {
+        top.max_child_height = std::max(top.max_child_height, known->second);
+        continue;
+      }
+      if (known != height->end()) {
         std::string cycle;
         bool in_cycle = false;
-        for (const std::string& s : *path) {
-          in_cycle = in_cycle || s == action.name;
-          if (in_cycle) cycle += "\"" + s + "\" -> ";
+        for (const Frame& f : path) {
+          in_cycle = in_cycle || f.script->name == action.name;
+          if (in_cycle) cycle += "\"" + f.script->name + "\" -> ";
         }
         Fail(action.location,
              "run_script makes scripts call each other forever: " + cycle +
                  "\"" + action.name + "\"");
       }
-      CheckNoCycle(*config_.FindScript(action.name), state, path);
+      (*height)[action.name] = -1;
+      path.push_back({config_.FindScript(action.name), 0, 0});
     }
-    path->pop_back();
-    (*state)[script.name] = 2;
   }
 
   Tokenizer tokenizer_;
@@ -629,6 +661,12 @@ SheriffConfig ParseSheriffConfig(std::string_view text,
 }
 
 SheriffConfig LoadSheriffConfig(const std::string& path) {
+  // An ifstream opens a directory without complaint and reads nothing: the
+  // config would silently be empty.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw std::runtime_error("sheriff config '" + path + "' is a directory, not a file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw std::runtime_error("cannot open sheriff config '" + path +

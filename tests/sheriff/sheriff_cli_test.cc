@@ -1,14 +1,21 @@
 // vimot-sheriff end to end: the binary, its output and its exit status.
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <thread>
 
+#include "tests/sheriff/proc_scan.h"
 #include "tests/sheriff/test_util.h"
 
+using vimot::sheriff::test::CountRunning;
 using vimot::sheriff::test::TempDir;
 
 namespace {
@@ -108,4 +115,64 @@ TEST_CASE("a demo run: simulator to completion, services stopped, its exit code"
     CHECK(r.output.find("[sim] bin=" + bin_dir + "\n") != std::string::npos);
   }
   CHECK(r.output.find("[sheriff] 'logger' stopped") != std::string::npos);
+}
+
+TEST_CASE("a directory as the config or a too deep config exits 2 with a message") {
+  TempDir dir;
+  Result r = RunSheriff("'" + dir.path() + "'");
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("is a directory, not a file") != std::string::npos);
+
+  std::string chain;
+  for (int i = 0; i < 40000; ++i) {
+    chain += "script \"s" + std::to_string(i) + "\" { run_script \"s" + std::to_string(i + 1) + "\"; }\n";
+  }
+  chain += "script \"s40000\" { wait ms 1; }\n";
+  r = RunSheriff("'" + WriteConfig(dir, "chain.pmd", chain) + "'");
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("run_script nests scripts more than 64 deep") != std::string::npos);
+}
+
+TEST_CASE("kill -9 of the sheriff leaves none of its commands running") {
+  TempDir dir;
+  // A program run directly, the program of a shell list, and a pipeline.
+  const std::string path = WriteConfig(dir, "kill.pmd", R"(
+    cmd "direct" { exec = "sleep 30.131"; stop_time_allowed = 1; }
+    cmd "list" { exec = "sleep 30.132; true"; stop_time_allowed = 1; }
+    cmd "pipeline" { exec = "sleep 30.133 | cat"; stop_time_allowed = 1; }
+  )");
+  const std::string log = dir.path() + "/sheriff.log";
+  const pid_t sheriff = ::fork();
+  REQUIRE(sheriff >= 0);
+  if (sheriff == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, STDOUT_FILENO);
+    ::dup2(fd, STDERR_FILENO);
+    ::execl(VIMOT_SHERIFF_BIN, VIMOT_SHERIFF_BIN, path.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto running = [] {
+    return CountRunning({"sleep", "30.131"}) + CountRunning({"sleep", "30.132"}) +
+           CountRunning({"sleep", "30.133"});
+  };
+  const auto wait_for = [](const std::function<bool()>& done) {
+    const auto end = std::chrono::steady_clock::now() + vimot::sheriff::test::kConditionTimeout;
+    while (!done() && std::chrono::steady_clock::now() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return done();
+  };
+  const bool started = wait_for([&] { return running() == 3; });
+  ::kill(sheriff, SIGKILL);
+  int status = 0;
+  ::waitpid(sheriff, &status, 0);
+  REQUIRE(started);
+  CHECK(WIFSIGNALED(status));
+  // Within the commands' stop_time_allowed (1 s) and a margin.
+  CHECK(wait_for([&] { return running() == 0; }));
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  INFO(text.str());
+  CHECK(text.str().find("[sheriff watchdog] the sheriff ended without stopping its commands") != std::string::npos);
 }
