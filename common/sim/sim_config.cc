@@ -24,6 +24,48 @@ std::string fmt(const Eigen::Vector3d& v) { return "[" + fmt(v.x()) + ", " + fmt
 
 // ---- validation (shared by validate() and from_config()) ------------------
 
+bool power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
+
+// Whole number of `unit`s in `length` (to 1e-6 relative).
+bool whole_multiple(double length, double unit) {
+  const double n = length / unit;
+  return std::round(n) >= 1.0 && std::abs(n - std::round(n)) < 1e-6 * n;
+}
+
+// The render section's problems, as problem().
+std::string render_problem(const SimConfig& c) {
+  const RenderConfig& r = c.render;
+  std::ostringstream err;
+  if (!(r.texel_size > 0.0) || !std::isfinite(r.texel_size)) {
+    err << "key 'render.texel_size' must be > 0, got " << fmt(r.texel_size);
+  } else if (!power_of_two(r.texture_size) || r.texture_size < 16 || r.texture_size > 8192) {
+    err << "key 'render.texture_size' must be a power of two in [16, 8192], got " << r.texture_size;
+  } else if (!power_of_two(r.target_texture_size) || r.target_texture_size < 16 || r.target_texture_size > 4096) {
+    err << "key 'render.target_texture_size' must be a power of two in [16, 4096], got " << r.target_texture_size;
+  } else if (!(r.checker_square > 0.0) || !std::isfinite(r.checker_square)) {
+    err << "key 'render.checker_square' must be > 0, got " << fmt(r.checker_square);
+  } else if (!(r.noise_sigma >= 0.0) || !std::isfinite(r.noise_sigma)) {
+    err << "key 'render.noise_sigma' must be >= 0, got " << fmt(r.noise_sigma);
+  } else if (!(r.exposure_amplitude >= 0.0 && r.exposure_amplitude <= 2.0)) {
+    err << "key 'render.exposure_amplitude' must be in [0, 2] (log gain), got " << fmt(r.exposure_amplitude);
+  } else if (!(r.exposure_frequency_hz >= 0.0) || !std::isfinite(r.exposure_frequency_hz)) {
+    err << "key 'render.exposure_frequency_hz' must be >= 0, got " << fmt(r.exposure_frequency_hz);
+  } else if (r.scene_texture == SurfaceTexture::kCheckerboard &&
+             !(whole_multiple(r.checker_square, r.texel_size) &&
+               r.texture_size % (2 * static_cast<int>(std::lround(r.checker_square / r.texel_size))) == 0)) {
+    // Square edges on texel boundaries and a whole number of square pairs
+    // per texture period, or the corners would not be where the config says.
+    err << "key 'render.checker_square' must be a whole number of texels (render.texel_size " << fmt(r.texel_size)
+        << " m) dividing half of render.texture_size " << r.texture_size << ", got " << fmt(r.checker_square);
+  } else if (r.target_texture == SurfaceTexture::kCheckerboard &&
+             !whole_multiple(r.checker_square, c.target.size.maxCoeff() / r.target_texture_size)) {
+    err << "key 'render.checker_square' must be a whole number of target texels (longest target edge "
+        << fmt(c.target.size.maxCoeff()) << " m / render.target_texture_size " << r.target_texture_size
+        << "), got " << fmt(r.checker_square);
+  }
+  return err.str();
+}
+
 // Returns "" or the first problem as "key 'a.b' must ..., got ...".
 std::string problem(const SimConfig& c) {
   std::ostringstream err;
@@ -86,6 +128,8 @@ std::string problem(const SimConfig& c) {
     err << "key 'target.min_view_cos' must be in [0, 1), got " << fmt(c.target.min_view_cos);
   }
   if (err.tellp() != 0) return err.str();
+  const std::string render = render_problem(c);
+  if (!render.empty()) return render;
   switch (c.scenario) {
     case Scenario::kPaper:
       if (positive("paper.radius", c.paper.radius) && positive("paper.speed", c.paper.speed) &&
@@ -234,6 +278,12 @@ ObjectHeading object_heading_from_string(const std::string& name) {
   throw std::invalid_argument("unknown object heading '" + name + "' (expected along_velocity or fixed)");
 }
 
+SurfaceTexture surface_texture_from_string(const std::string& name) {
+  if (name == "pattern") return SurfaceTexture::kPattern;
+  if (name == "checkerboard") return SurfaceTexture::kCheckerboard;
+  throw std::invalid_argument("unknown surface texture '" + name + "' (expected pattern or checkerboard)");
+}
+
 void validate(const SimConfig& config) {
   const std::string p = problem(config);
   if (!p.empty()) throw std::invalid_argument("SimConfig: " + p);
@@ -244,7 +294,7 @@ SimConfig from_config(const Config& config) {
   SimConfig c;
   r.only_keys("", {"scenario", "seed", "map_seed", "start_utime", "duration", "ground_truth_events",
                    "calibration_file", "cameras", "imu", "camera", "map", "target", "paper", "trajectory", "mono",
-                   "comment",
+                   "render", "comment",
                    // Read by the process that runs the simulator (drivers/sim), not here.
                    "channels"});
   const std::string scenario = config.get<std::string>("scenario");
@@ -385,6 +435,24 @@ SimConfig from_config(const Config& config) {
   r.read_vec2("mono.room_min", &c.mono.room_min);
   r.read_vec2("mono.room_max", &c.mono.room_max);
   r.read("mono.spline_dt", &c.mono.spline_dt);
+
+  r.only_keys("render", {"texel_size", "texture_size", "target_texture_size", "scene_texture", "target_texture",
+                         "checker_square", "noise_sigma", "exposure_amplitude", "exposure_frequency_hz"});
+  r.read("render.texel_size", &c.render.texel_size);
+  r.read("render.texture_size", &c.render.texture_size);
+  r.read("render.target_texture_size", &c.render.target_texture_size);
+  for (const auto& [key, out] : {std::pair<const char*, SurfaceTexture*>{"render.scene_texture", &c.render.scene_texture},
+                                 {"render.target_texture", &c.render.target_texture}}) {
+    try {
+      if (config.has(key)) *out = surface_texture_from_string(config.get<std::string>(key));
+    } catch (const std::invalid_argument& e) {
+      r.fail(key, std::string("is invalid: ") + e.what());
+    }
+  }
+  r.read("render.checker_square", &c.render.checker_square);
+  r.read("render.noise_sigma", &c.render.noise_sigma);
+  r.read("render.exposure_amplitude", &c.render.exposure_amplitude);
+  r.read("render.exposure_frequency_hz", &c.render.exposure_frequency_hz);
 
   const std::string p = problem(c);
   if (!p.empty()) throw ConfigError("config '" + config.source() + "': " + p);

@@ -160,6 +160,29 @@ struct MonoScenarioConfig {
   double spline_dt{0.05};                // s
 };
 
+/// Surface texture of the rendered images (common/sim/renderer.h).
+enum class SurfaceTexture {
+  kPattern,       // procedural multi-scale shapes (texture.h)
+  kCheckerboard,  // squares of render.checker_square: corners at known positions (tests, calibration)
+};
+SurfaceTexture surface_texture_from_string(const std::string& name);
+
+/// The rendered images (vimot-sim --render, sim::Renderer); ignored by the
+/// measurement-level simulation.
+struct RenderConfig {
+  double texel_size{0.004};   // m, scene texture resolution (mip level 0)
+  int texture_size{2048};     // texels, side of the scene textures (power of 2); they repeat every side · texel_size
+  int target_texture_size{512};  // texels along the longest edge of the target (power of 2)
+  SurfaceTexture scene_texture{SurfaceTexture::kPattern};
+  SurfaceTexture target_texture{SurfaceTexture::kPattern};
+  double checker_square{0.5};  // m, square of the checkerboard textures
+  double noise_sigma{2.0};     // grey levels, σ of the white image noise (0 = none)
+  /// Exposure: every image's grey values are multiplied by
+  /// exp(exposure_amplitude sin(2π exposure_frequency_hz t + φ)), φ from the seed.
+  double exposure_amplitude{0.1};
+  double exposure_frequency_hz{0.05};  // Hz
+};
+
 struct SimConfig {
   Scenario scenario{Scenario::kPaper};
   uint64_t seed{1};       // measurement noise: IMU, pixels, track loss
@@ -178,6 +201,7 @@ struct SimConfig {
   PaperScenarioConfig paper;
   TrajectoryScenarioConfig trajectory;
   MonoScenarioConfig mono;
+  RenderConfig render;
 };
 
 /// Seed of random stream `stream` of `seed` (splitmix64 mixing): the

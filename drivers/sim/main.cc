@@ -1,26 +1,60 @@
 // vimot-sim: the simulator as a sensor driver. Publishes IMU, FEATURES and
 // GROUND_TRUTH on LCM at real time or any speed factor, or writes them
-// straight into an LCM log file as fast as the CPU allows. The simulation
-// itself is common/sim (no LCM); this file only converts and paces.
+// straight into an LCM log file as fast as the CPU allows. With --render it
+// publishes rendered camera images (and the true target mask and box)
+// instead of FEATURES. The simulation and the rendering are common/sim (no
+// LCM); this file only converts and paces.
 #include <variant>
 
 #include "common/process/event_sink.h"
 #include "common/process/lcm_conversions.h"
 #include "common/process/process.h"
+#include "common/sim/renderer.h"
 #include "common/sim/simulator.h"
+#include "common/process/image_conversion.h"
+#include "vimot/mask_t.hpp"
+#include "vimot/target_box_t.hpp"
 
 namespace {
 
 using vimot::log_info;
 
+vimot::mask_t to_mask_msg(const vimot::sim::RenderedView& view) {
+  vimot::mask_t msg;
+  msg.utime = view.utime;
+  msg.camera_id = static_cast<int8_t>(view.camera_id);
+  msg.width = view.mask.cols;
+  msg.height = view.mask.rows;
+  msg.data.assign(view.mask.datastart, view.mask.dataend);
+  msg.size = static_cast<int32_t>(msg.data.size());
+  return msg;
+}
+
+// The true box as a mask filter would report a perfect detection: raw =
+// filtered, no coasting, zero covariance and velocity.
+vimot::target_box_t to_box_msg(const vimot::sim::RenderedView& view) {
+  vimot::target_box_t msg{};
+  msg.utime = view.utime;
+  msg.camera_id = static_cast<int8_t>(view.camera_id);
+  msg.raw_valid = view.visible;
+  msg.filtered_valid = view.visible;
+  for (int k = 0; k < 4; ++k) msg.raw_box[k] = msg.filtered_box[k] = view.box(k);
+  msg.frames_since_raw = 0;
+  return msg;
+}
+
 int run(int argc, const char* const* argv) {
   vimot::Process process("vimot-sim",
                          "Simulates a scenario (config/sim_*.yaml) and publishes IMU, FEATURES and\n"
-                         "GROUND_TRUTH on LCM, paced by --speed, or writes them to an LCM log (--log).",
+                         "GROUND_TRUTH on LCM, paced by --speed, or writes them to an LCM log (--log).\n"
+                         "--render: rendered images on CAM_LEFT / CAM_RIGHT and the true target mask and\n"
+                         "box (TARGET_MASK_TRUTH, TARGET_BOX_TRUTH) per camera instead of FEATURES.",
                          /*config_required=*/true);
   process.args().add_option("seed", "N", "noise seed (overrides the config's seed)");
   process.args().add_option("duration", "SECONDS", "simulate only this long (overrides the config)");
   vimot::add_sink_options(process.args());
+  process.args().add_flag("render", "publish rendered images, target masks and boxes instead of FEATURES");
+  process.args().add_flag("with-features", "with --render, publish FEATURES too");
   if (!process.init(argc, argv)) return 0;
 
   vimot::sim::SimConfig config = vimot::sim::from_config(process.config());
@@ -31,6 +65,17 @@ int run(int argc, const char* const* argv) {
   const std::string imu_channel = process.channel("imu", "IMU");
   const std::string features_channel = process.channel("features", "FEATURES");
   const std::string truth_channel = process.channel("ground_truth", "GROUND_TRUTH");
+  const bool render = process.args().given("render");
+  if (process.args().given("with-features") && !render) {
+    throw vimot::ArgError("vimot-sim: --with-features needs --render");
+  }
+  const bool publish_features = !render || process.args().given("with-features");
+  const std::string camera_channels[2] = {process.channel("cam_left", "CAM_LEFT"),
+                                          process.channel("cam_right", "CAM_RIGHT")};
+  const std::string mask_channel = process.channel("target_mask_truth", "TARGET_MASK_TRUTH");
+  const std::string box_channel = process.channel("target_box_truth", "TARGET_BOX_TRUTH");
+  std::unique_ptr<vimot::sim::Renderer> renderer;
+  if (render) renderer = std::make_unique<vimot::sim::Renderer>(sim);
 
   const std::unique_ptr<vimot::EventSink> sink = vimot::make_sink(process, sim.start_utime());
   log_info("scenario ", vimot::sim::to_string(config.scenario), ", seed ", config.seed, ", ", sim.duration(),
@@ -38,7 +83,7 @@ int run(int argc, const char* const* argv) {
            sim.camera_frame_count(), " camera frames",
            process.args().given("log") ? ", writing " + process.args().get("log") : "");
 
-  int64_t counts[3] = {0, 0, 0};
+  int64_t counts[4] = {0, 0, 0, 0};
   vimot::ProgressLog progress(sim.duration());
   while (!process.stop_requested()) {
     const std::optional<vimot::sim::SimEvent> event = sim.next();
@@ -49,9 +94,19 @@ int run(int argc, const char* const* argv) {
       utime = imu->utime;
       ++counts[0];
     } else if (const auto* frame = std::get_if<vimot::CameraFrame>(&*event)) {
-      vimot::emit(*sink, features_channel, vimot::to_lcm(*frame));
+      if (publish_features) {
+        vimot::emit(*sink, features_channel, vimot::to_lcm(*frame));
+        ++counts[1];
+      }
+      if (renderer) {
+        for (const vimot::sim::RenderedView& view : renderer->render(frame->utime)) {
+          vimot::emit(*sink, camera_channels[view.camera_id], vimot::to_lcm_image(view.image, view.utime));
+          vimot::emit(*sink, mask_channel, to_mask_msg(view));
+          vimot::emit(*sink, box_channel, to_box_msg(view));
+          ++counts[3];
+        }
+      }
       utime = frame->utime;
-      ++counts[1];
     } else if (const auto* truth = std::get_if<vimot::GroundTruth>(&*event)) {
       vimot::emit(*sink, truth_channel, vimot::to_lcm(*truth));
       utime = truth->utime;
@@ -60,7 +115,8 @@ int run(int argc, const char* const* argv) {
     progress.update(sim.sim_time(utime));
   }
   log_info(process.stop_requested() ? "stopped early: " : "done: ", counts[0], " on ", imu_channel, ", ", counts[1],
-           " on ", features_channel, ", ", counts[2], " on ", truth_channel);
+           " on ", features_channel, ", ", counts[2], " on ", truth_channel,
+           render ? ", " + std::to_string(counts[3]) + " rendered images (+ masks, boxes)" : std::string());
   vimot::linger(process, process.args().get_double("linger"));
   return 0;
 }
