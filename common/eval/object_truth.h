@@ -1,7 +1,7 @@
 #pragma once
 // Truth of the up-to-scale object pose from the simulator, for the tracker
 // tests and the evaluator. The tracker's object frame O (see
-// procs/object_tracker/object_tracker.h) is rigid in the target T:
+// common/object/object_tracker.h) is rigid in the target T:
 //  * R_OtoC0 = I at the reference frame, so R_OtoT = R_TtoC0^T;
 //  * O sits at s_true along the centre ray u: p_OinC0 = s_true u, where
 //    s_true = median of the true distances |p_FinC0| of the reference

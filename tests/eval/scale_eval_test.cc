@@ -1,4 +1,4 @@
-// The figures of vimot-scale-eval (procs/eval/scale_eval.h) against values
+// The figures of vimot-scale-eval (common/eval/scale_eval.h) against values
 // derived by hand: the metric object pose error in G and its yaw/pitch/roll,
 // scale errors per track, mean / std per axis, the median / max of |e|, and
 // the tracks' truth through summary.json (what vimot-log-eval reads back).
