@@ -157,6 +157,7 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& pixel) const {
   if (!pixel.allFinite()) {
     throw std::runtime_error("CameraModel::undistort: pixel " + fmt_pixel(pixel) + " is not finite");
   }
+  if (calib_.distortion_model == DistortionModel::kEquidistant) return undistort_equidistant(pixel);
   // The distorted normalized point is the first guess: distortion moves a
   // point by a fraction of its radius, so it starts on the right branch.
   Eigen::Vector2d x((pixel.x() - calib_.intrinsics(2)) / calib_.intrinsics(0),
@@ -196,6 +197,36 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& pixel) const {
                            " iterations (far outside the image of a " + std::to_string(calib_.width) + "x" +
                            std::to_string(calib_.height) +
                            " camera, or beyond the range where the distortion model is invertible)");
+}
+
+Eigen::Vector2d CameraModel::undistort_equidistant(const Eigen::Vector2d& pixel) const {
+  // The model is radial, so inverting it is one equation in the angle θ off
+  // the optical axis: θd = θ (1 + k1 θ² + k2 θ⁴ + k3 θ⁶ + k4 θ⁸), solved by
+  // Newton from θ = θd; then r = tan θ. (Newton on x itself would chase r to
+  // infinity near 90° where tan θ blows up.)
+  const Eigen::Vector2d xd((pixel.x() - calib_.intrinsics(2)) / calib_.intrinsics(0),
+                           (pixel.y() - calib_.intrinsics(3)) / calib_.intrinsics(1));
+  const double theta_d = xd.norm();
+  if (theta_d < kEquidistantSmallRadius) return xd;
+  const Eigen::Vector4d& k = calib_.distortion;
+  double theta = theta_d;
+  for (int iter = 0; iter < kMaxUndistortIterations; ++iter) {
+    const double t2 = theta * theta;
+    const double f = theta * (1.0 + t2 * (k(0) + t2 * (k(1) + t2 * (k(2) + t2 * k(3))))) - theta_d;
+    const double df = 1.0 + t2 * (3.0 * k(0) + t2 * (5.0 * k(1) + t2 * (7.0 * k(2) + t2 * 9.0 * k(3))));
+    // dθd/dθ <= 0: past the angle where the lens model turns back, no ray.
+    if (!(df > 0.0)) break;
+    const double step = f / df;
+    theta -= step;
+    if (std::abs(step) < kUndistortStepTolerance) {
+      // A ray at 90° or more from the axis has no point on the plane z = 1.
+      if (!(theta > 0.0 && theta < 0.5 * M_PI)) break;
+      return xd * (std::tan(theta) / theta_d);
+    }
+  }
+  throw std::runtime_error("CameraModel::undistort: no ray in front of the equidistant camera for pixel " +
+                           fmt_pixel(pixel) + " (the model does not invert there, or the ray is 90 degrees or more "
+                           "off the optical axis)");
 }
 
 bool CameraModel::in_image(const Eigen::Vector2d& pixel, double border) const {

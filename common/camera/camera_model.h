@@ -43,8 +43,10 @@ class CameraModel {
   /// d pixel / d normalized, analytic.
   Eigen::Matrix2d distort_jacobian(const Eigen::Vector2d& normalized) const;
 
-  /// Pixel -> normalized, by Gauss-Newton on distort(); throws
-  /// std::runtime_error if it does not converge (far outside the image).
+  /// Pixel -> normalized, by Gauss-Newton on distort() (radtan) or Newton on
+  /// the angle off the axis (equidistant); throws std::runtime_error if it
+  /// does not converge (far outside the image) or, for a fisheye, the ray is
+  /// 90 degrees or more off the axis (no point on z = 1).
   Eigen::Vector2d undistort(const Eigen::Vector2d& pixel) const;
 
   /// True if the pixel lies inside the image with `border` pixels margin.
@@ -54,6 +56,8 @@ class CameraModel {
   double mean_focal() const { return 0.5 * (calib_.intrinsics(0) + calib_.intrinsics(1)); }
 
  private:
+  Eigen::Vector2d undistort_equidistant(const Eigen::Vector2d& pixel) const;
+
   CameraCalibration calib_;
 };
 

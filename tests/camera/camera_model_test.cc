@@ -214,13 +214,13 @@ TEST_CASE("undistort agrees with OpenCV undistortPoints where OpenCV converges")
   }
 }
 
-// A fisheye lens of the EuRoC-like size (Kalibr equidistant values of a
-// 185-degree T265-class lens scaled to 752x480).
+// A fisheye lens on a 752x480 sensor (Kalibr equidistant coefficients of a
+// T265-class lens); its image corners lie 74 degrees off the axis.
 CameraCalibration fisheye_lens() {
   CameraCalibration c;
   c.width = 752;
   c.height = 480;
-  c.intrinsics << 285.0, 286.0, 380.0, 242.0;
+  c.intrinsics << 350.0, 351.0, 380.0, 242.0;
   c.distortion_model = DistortionModel::kEquidistant;
   c.distortion << -0.0073, 0.0434, -0.0405, 0.0076;
   return c;
@@ -285,6 +285,9 @@ TEST_CASE("equidistant undistort inverts distort and agrees with OpenCV fisheye:
     max_error = std::max(max_error, (n - Eigen::Vector2d(cv_normalized[i].x, cv_normalized[i].y)).norm());
   }
   CHECK(max_error < 1e-8);
+  // 2.2 rad (126 degrees) off the axis: no point on the plane z = 1.
+  const std::string msg = message_of<std::runtime_error>([&] { cam.undistort(Eigen::Vector2d(380.0 + 770.0, 242.0)); });
+  CHECK_THAT(msg, Catch::Contains("1150") && Catch::Contains("90 degrees"));
 }
 
 TEST_CASE("undistort throws naming the pixel where the model has no inverse") {
