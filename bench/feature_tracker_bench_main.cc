@@ -94,6 +94,7 @@ int run(int argc, const char* const* argv) {
 
   cv::setNumThreads(1);
   std::vector<double> wall_ms, cpu_ms;
+  frontend::TrackerTiming stage_sum;
   frontend::TrackingFigures figures;
   for (long long pass = 0; pass < repeat; ++pass) {
     frontend::FeatureTracker tracker(options, cameras);
@@ -105,6 +106,13 @@ int run(int argc, const char* const* argv) {
       const auto t1 = std::chrono::steady_clock::now();
       cpu_ms.push_back(thread_cpu_ms() - c0);
       wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      const frontend::TrackerTiming& st = tracker.last_timing();
+      stage_sum.preprocess_ms += st.preprocess_ms;
+      stage_sum.static_temporal_ms += st.static_temporal_ms;
+      stage_sum.detect_ms += st.detect_ms;
+      stage_sum.static_stereo_ms += st.static_stereo_ms;
+      stage_sum.target_ms += st.target_ms;
+      stage_sum.total_ms += st.total_ms;
       if (pass == 0) stats.add(frame);
     }
     if (pass == 0) figures = stats.figures();
@@ -122,6 +130,12 @@ int run(int argc, const char* const* argv) {
   std::printf("wall time per %s: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms (includes waiting for the "
               "CPU on a shared machine)\n",
               unit, wall.mean, wall.median, wall.p95, wall.max);
+  // Stage shares of the wall time (their ratios hold on a loaded machine).
+  std::printf("profile (share of wall time): preprocess %.0f %%, KLT frame to frame + RANSAC %.0f %%, FAST grid "
+              "%.0f %%, stereo KLT + RANSAC %.0f %%, target %.0f %%\n",
+              100.0 * stage_sum.preprocess_ms / stage_sum.total_ms,
+              100.0 * stage_sum.static_temporal_ms / stage_sum.total_ms, 100.0 * stage_sum.detect_ms / stage_sum.total_ms,
+              100.0 * stage_sum.static_stereo_ms / stage_sum.total_ms, 100.0 * stage_sum.target_ms / stage_sum.total_ms);
   std::printf("static features per frame (cam0): min %d after the first, mean %.1f\n", figures.min_static_per_frame,
               figures.mean_static_per_frame);
   std::printf("median track length: %.1f frames\n", figures.median_track_length);

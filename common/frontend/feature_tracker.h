@@ -33,6 +33,17 @@
 
 namespace vimot::frontend {
 
+/// Wall time of each stage of the last track() call (ms), for the
+/// benchmark's profile.
+struct TrackerTiming {
+  double preprocess_ms{0.0};       // histogram equalisation + KLT pyramids
+  double static_temporal_ms{0.0};  // KLT frame to frame + RANSAC, both cameras
+  double detect_ms{0.0};           // FAST grid + undistortion of new corners
+  double static_stereo_ms{0.0};    // KLT left to right + RANSAC
+  double target_ms{0.0};           // ORB, matching, RANSAC, loop closure
+  double total_ms{0.0};
+};
+
 class FeatureTracker {
  public:
   /// One camera (mono) or two (stereo: cam0 left, cam1 right). Throws
@@ -55,6 +66,7 @@ class FeatureTracker {
   std::size_t stored_target_points() const { return store_.size(); }
   /// Target tracks that got an old id back by descriptor (loop closures).
   int64_t loop_closures() const { return loop_closures_; }
+  const TrackerTiming& last_timing() const { return timing_; }
 
  private:
   struct Point {
@@ -88,9 +100,11 @@ class FeatureTracker {
   TargetPointStore store_;
 
   int64_t next_id_{0};
+  int64_t first_new_id_{0};
   int64_t frame_index_{0};
   int64_t last_utime_{0};
   int64_t loop_closures_{0};
+  TrackerTiming timing_;
   // Per camera: the previous frame's pyramid, static points, target points
   // and box; `pyramid_` is the current frame's during track().
   std::vector<std::vector<cv::Mat>> prev_pyramid_, pyramid_;

@@ -29,10 +29,10 @@ struct StaticTrackOptions {
   int fast_threshold{15};      // FAST intensity threshold (grey levels)
   double min_distance_px{15};  // no new corner this close to a tracked one
   int border_px{8};            // corners and tracks keep this far from the image edge
-  int klt_window_px{21};       // KLT window side (odd)
+  int klt_window_px{15};       // KLT window side (odd)
   int klt_pyramid_levels{3};   // levels above the full image
-  int klt_max_iterations{30};
-  double klt_epsilon{0.01};    // px, KLT stop criterion
+  int klt_max_iterations{20};
+  double klt_epsilon{0.03};    // px, KLT stop criterion
   void validate() const;
 };
 
