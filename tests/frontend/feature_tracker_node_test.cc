@@ -1,0 +1,174 @@
+// FeatureTrackerNode without a network: stereo pairing by utime, dropped
+// unpaired and late images, wrong-size images as counted errors, target
+// boxes by utime, mono; and image_t -> cv::Mat for the process.
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+#include "common/config/config.h"
+#include "common/process/image_conversion.h"
+#include "procs/feature_tracker/feature_tracker_node.h"
+#include "tests/frontend/synthetic_images.h"
+
+using namespace vimot;
+
+namespace {
+
+struct Recorder {
+  std::vector<CameraFrame> frames;
+  std::vector<VinsEvent> events;
+  int count(VinsEvent::Kind kind) const {
+    int n = 0;
+    for (const VinsEvent& e : events) n += e.kind == kind ? 1 : 0;
+    return n;
+  }
+};
+
+FeatureTrackerNodeOptions options(int cameras) {
+  FeatureTrackerNodeOptions o;
+  const CameraCalibration cam = test::pinhole(320, 240, 250.0);
+  o.cameras.assign(static_cast<std::size_t>(cameras), cam);
+  return o;
+}
+
+FeatureTrackerNode make_node(const FeatureTrackerNodeOptions& o, Recorder& r) {
+  return FeatureTrackerNode(
+      o, [&r](const CameraFrame& f) { r.frames.push_back(f); }, [&r](const VinsEvent& e) { r.events.push_back(e); });
+}
+
+}  // namespace
+
+TEST_CASE("the node pairs left and right by utime in either arrival order and drops the unpaired") {
+  Recorder r;
+  FeatureTrackerNode node = make_node(options(2), r);
+  const cv::Mat image = test::make_texture(320, 240, 51, 400);
+  node.on_image(0, 100, image);
+  CHECK(r.frames.empty());
+  node.on_image(1, 100, image);
+  REQUIRE(r.frames.size() == 1);
+  CHECK(r.frames[0].utime == 100);
+  node.on_image(1, 200, image);  // right first
+  node.on_image(0, 200, image);
+  REQUIRE(r.frames.size() == 2);
+  CHECK(r.frames[1].utime == 200);
+  // A left image whose right never comes is dropped once a later pair completes.
+  node.on_image(0, 300, image);
+  node.on_image(0, 400, image);
+  node.on_image(1, 400, image);
+  REQUIRE(r.frames.size() == 3);
+  CHECK(r.frames[2].utime == 400);
+  CHECK(node.images_dropped() == 1);
+  CHECK(r.count(VinsEvent::Kind::kDropped) == 1);
+  // Late (not after the last tracked frame) and duplicate images are dropped.
+  node.on_image(1, 350, image);
+  node.on_image(0, 500, image);
+  node.on_image(0, 500, image);
+  CHECK(node.images_dropped() == 3);
+  // Stereo observations carry one id in both cameras.
+  bool both = false;
+  for (const FeatureObservation& o : r.frames[2].observations) both = both || o.camera_id == 1;
+  CHECK(both);
+  CHECK(node.errors() == 0);
+}
+
+TEST_CASE("the node bounds the images waiting for a partner") {
+  Recorder r;
+  FeatureTrackerNodeOptions o = options(2);
+  o.max_pending_images = 2;
+  FeatureTrackerNode node = make_node(o, r);
+  const cv::Mat image = test::make_texture(320, 240, 52, 400);
+  for (int k = 1; k <= 5; ++k) node.on_image(0, k * 100, image);
+  CHECK(node.images_dropped() == 3);
+  node.on_image(1, 500, image);
+  CHECK(r.frames.size() == 1);
+  CHECK(node.images_dropped() == 4);  // 400 never found its partner
+}
+
+TEST_CASE("the node counts a wrong-size or non-grey image as an error and carries on") {
+  Recorder r;
+  FeatureTrackerNode node = make_node(options(2), r);
+  const cv::Mat image = test::make_texture(320, 240, 53, 400);
+  node.on_image(0, 100, test::make_texture(640, 480, 53, 400));
+  CHECK(node.errors() == 1);
+  REQUIRE(r.count(VinsEvent::Kind::kError) == 1);
+  CHECK_THAT(r.events.back().message, Catch::Contains("640x480") && Catch::Contains("320x240"));
+  cv::Mat colour;
+  cv::cvtColor(image, colour, cv::COLOR_GRAY2BGR);
+  node.on_image(1, 100, colour);
+  CHECK(node.errors() == 2);
+  node.on_image(2, 100, image);
+  CHECK(node.errors() == 3);
+  node.on_image(0, 100, image);
+  node.on_image(1, 100, image);
+  CHECK(r.frames.size() == 1);
+}
+
+TEST_CASE("the node uses each camera's box at or before the frame, and mono tracks the left alone") {
+  Recorder r;
+  FeatureTrackerNode node = make_node(options(1), r);
+  CHECK_FALSE(node.stereo());
+  const cv::Mat image = test::make_texture(320, 240, 54, 400);
+  node.on_image(0, 100, image);
+  REQUIRE(r.frames.size() == 1);
+  for (const FeatureObservation& o : r.frames[0].observations) CHECK_FALSE(o.is_target);
+  const frontend::Box box{100.0, 60.0, 120.0, 100.0};
+  node.on_box(0, 200, box);
+  node.on_box(0, 400, frontend::Box{0.0, 0.0, 10.0, 10.0});  // for a later image: not used at 200
+  node.on_image(0, 200, image);
+  REQUIRE(r.frames.size() == 2);
+  int targets = 0;
+  for (const FeatureObservation& o : r.frames[1].observations) {
+    CHECK(o.is_target == box.contains(o.pixel.x(), o.pixel.y()));
+    targets += o.is_target ? 1 : 0;
+  }
+  CHECK(targets > 0);
+  node.on_image(1, 300, image);
+  CHECK(node.errors() == 1);  // a mono tracker has no right camera
+  node.on_box(0, 250, frontend::Box{std::nan(""), 0.0, 1.0, 1.0});
+  CHECK(node.errors() == 2);
+}
+
+TEST_CASE("FeatureTrackerNodeOptions reads config/feature_tracker.yaml and refuses unknown keys") {
+  const Config cfg = Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/feature_tracker.yaml");
+  const FeatureTrackerNodeOptions o = FeatureTrackerNodeOptions::from_config(cfg);
+  REQUIRE(o.cameras.size() == 2);
+  CHECK(o.cameras[0].width == 752);
+  CHECK(o.max_pending_images == 4);
+  const std::string text = "calibration_file: " + std::string(VIMOT_SOURCE_DIR) +
+                           "/config/euroc_stereo.yaml\nmode: mono\nnode: {box_max_age: 1}\n";
+  CHECK_THROWS_WITH(FeatureTrackerNodeOptions::from_config(Config::from_string(text, "ft.yaml")),
+                    Catch::Contains("node.box_max_age") && Catch::Contains("unknown"));
+  CHECK(FeatureTrackerNodeOptions::from_config(
+            Config::from_string("calibration_file: " + std::string(VIMOT_SOURCE_DIR) + "/config/euroc_stereo.yaml\n"
+                                "mode: mono\n", "ft.yaml"))
+            .cameras.size() == 1);
+}
+
+TEST_CASE("image_from_lcm copies a grey image row by row and refuses what it cannot read") {
+  image_t m;
+  m.utime = 7;
+  m.width = 3;
+  m.height = 2;
+  m.row_stride = 4;
+  m.pixelformat = image_t::PIXEL_FORMAT_GRAY;
+  m.data = {1, 2, 3, 99, 4, 5, 6, 99};
+  m.size = static_cast<int32_t>(m.data.size());
+  m.nmetadata = 0;
+  const cv::Mat img = image_from_lcm(m);
+  REQUIRE(img.type() == CV_8UC1);
+  REQUIRE(img.cols == 3);
+  REQUIRE(img.rows == 2);
+  CHECK(img.at<uint8_t>(1, 0) == 4);
+  CHECK(img.at<uint8_t>(1, 2) == 6);
+  image_t rgb = m;
+  rgb.pixelformat = image_t::PIXEL_FORMAT_RGB;
+  CHECK_THROWS_WITH(image_from_lcm(rgb), Catch::Contains("pixel format") && Catch::Contains("GRAY"));
+  image_t short_data = m;
+  short_data.data.resize(5);
+  short_data.size = 5;
+  CHECK_THROWS_WITH(image_from_lcm(short_data), Catch::Contains("needs 7"));
+  image_t narrow = m;
+  narrow.row_stride = 2;
+  CHECK_THROWS_WITH(image_from_lcm(narrow), Catch::Contains("row_stride"));
+}
