@@ -271,3 +271,40 @@ TEST_CASE("the tracker rejects bad input with a message and stays usable") {
   CHECK_THAT(message([&] { mono.track(0, image, image, std::nullopt, std::nullopt); }), Catch::Contains("mono"));
   CHECK_THROWS_AS(FeatureTracker(FeatureTrackerOptions{}, {}), std::invalid_argument);
 }
+
+TEST_CASE("stereo target features share one id in both cameras, at the target's disparity") {
+  // A rectified-like rig: cam1 10 cm to the right of cam0, same orientation,
+  // so a point's disparity is purely horizontal. The background is the same
+  // image in both cameras (a scene at infinity); the target patch sits
+  // 24 px further left in the right image (a target 1.7 m away).
+  CameraCalibration left = test::pinhole(640, 480, 400.0), right = left;
+  right.p_IinC = Eigen::Vector3d(-0.1, 0.0, 0.0);
+  const cv::Mat background = test::make_texture(640, 480, 61, 1500);
+  const cv::Mat patch = test::make_texture(kPatchW, kPatchH, 62, 150);
+  FeatureTracker tracker(FeatureTrackerOptions{}, {left, right});
+  const cv::Point disparity(24, 0);
+  std::map<int64_t, Eigen::Vector2d> first_left;
+  for (int k = 0; k < 2; ++k) {
+    const cv::Point a(200 + 15 * k, 150 + 8 * k);
+    const CameraFrame f = tracker.track(k * 50000, scene(background, patch, a), scene(background, patch, a - disparity),
+                                        box_at(a), box_at(a - disparity));
+    const auto l = pixels_of(f, 0, true), r = pixels_of(f, 1, true);
+    int shared = 0, correct = 0;
+    for (const auto& [id, px] : r) {
+      const auto it = l.find(id);
+      if (it == l.end()) continue;
+      ++shared;
+      correct += (it->second - px - Eigen::Vector2d(disparity.x, disparity.y)).norm() < 2.0 ? 1 : 0;
+    }
+    INFO("frame " << k << ": " << shared << " stereo target points of " << l.size() << " left, " << correct
+                  << " at the disparity");
+    CHECK(shared >= static_cast<int>(l.size()) / 2);
+    CHECK(correct >= 0.95 * shared);
+    if (k == 0) first_left = l;
+    if (k == 1) {
+      int kept = 0;
+      for (const auto& [id, px] : l) kept += first_left.count(id);
+      CHECK(kept >= static_cast<int>(l.size()) / 2);
+    }
+  }
+}
