@@ -53,7 +53,10 @@ void TrackingStats::add(const CameraFrame& frame) {
   std::set<int64_t> seen;
   std::unordered_map<int64_t, Eigen::Vector2d> left;
   for (const FeatureObservation& o : frame.observations) {
-    if (o.is_target) continue;
+    if (o.is_target) {
+      target_observations_ += o.camera_id == 0 ? 1 : 0;
+      continue;
+    }
     seen.insert(o.feature_id);
     if (o.camera_id == 0) {
       ++n_static;
@@ -79,6 +82,8 @@ TrackingFigures TrackingStats::figures() const {
   if (!static_per_frame_.empty()) {
     f.mean_static_per_frame = std::accumulate(static_per_frame_.begin(), static_per_frame_.end(), 0.0) /
                               static_cast<double>(static_per_frame_.size());
+    f.mean_target_per_frame =
+        static_cast<double>(target_observations_) / static_cast<double>(static_per_frame_.size());
   }
   std::vector<double> lengths;
   for (const auto& [id, n] : track_length_) lengths.push_back(n);

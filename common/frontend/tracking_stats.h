@@ -21,6 +21,7 @@ struct TrackingFigures {
   /// (the first can only hold fresh detections); 0 with < 2 frames.
   int min_static_per_frame{0};
   double mean_static_per_frame{0.0};
+  double mean_target_per_frame{0.0};  // camera 0
   /// Median over static tracks of the frames each was seen in (any camera).
   double median_track_length{0.0};
   /// Median over stereo observations (static, same id in both cameras in a
@@ -48,6 +49,7 @@ class TrackingStats {
   Eigen::Matrix3d E_{Eigen::Matrix3d::Zero()};
   double focal1_{0.0};
   std::vector<int> static_per_frame_;
+  int64_t target_observations_{0};  // camera 0
   std::map<int64_t, int> track_length_;
   std::vector<double> epipolar_px_;
 };
