@@ -7,17 +7,16 @@
 // Images are decoded before timing, so the figures are the tracker's alone.
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <iostream>
 #include <numeric>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "common/camera/camera_model.h"
 #include "common/config/config.h"
@@ -44,7 +43,8 @@ struct Summary {
 Summary summarize(const std::vector<double>& v) {
   std::vector<double> sorted = v;
   std::sort(sorted.begin(), sorted.end());
-  const std::size_t i95 = std::min(sorted.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(sorted.size())));
+  const std::size_t i95 =
+      std::min(sorted.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(sorted.size())));
   return {std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()), frontend::median(v), sorted[i95],
           sorted.back()};
 }
@@ -77,7 +77,8 @@ int run(int argc, const char* const* argv) {
   if (args.given("box")) {
     frontend::Box b;
     char extra = 0;
-    if (std::sscanf(args.get("box").c_str(), "%lf,%lf,%lf,%lf%c", &b.x_min, &b.y_min, &b.width, &b.height, &extra) != 4) {
+    if (std::sscanf(args.get("box").c_str(), "%lf,%lf,%lf,%lf%c", &b.x_min, &b.y_min, &b.width, &b.height, &extra) !=
+        4) {
       throw ArgError("--box must be X,Y,W,H, got '" + args.get("box") + "'");
     }
     box = b;
@@ -137,17 +138,19 @@ int run(int argc, const char* const* argv) {
   std::printf("folder: %s (%zu %s frames of %dx%d, %lld passes)\n", folder.c_str(), utimes.size(),
               stereo ? "stereo" : "mono", cameras[0].width, cameras[0].height, repeat);
   const char* unit = stereo ? "stereo pair" : "frame";
-  std::printf("CPU time per %s: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms\n", unit, cpu.mean,
-              cpu.median, cpu.p95, cpu.max);
-  std::printf("wall time per %s: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms (includes waiting for the "
-              "CPU on a shared machine)\n",
-              unit, wall.mean, wall.median, wall.p95, wall.max);
+  std::printf("CPU time per %s: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms\n", unit, cpu.mean, cpu.median,
+              cpu.p95, cpu.max);
+  std::printf(
+      "wall time per %s: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms (includes waiting for the "
+      "CPU on a shared machine)\n",
+      unit, wall.mean, wall.median, wall.p95, wall.max);
   // Stage shares of the wall time (their ratios hold on a loaded machine).
-  std::printf("profile (share of wall time): preprocess %.0f %%, KLT frame to frame + RANSAC %.0f %%, FAST grid "
-              "%.0f %%, stereo KLT + RANSAC %.0f %%, target %.0f %%\n",
-              100.0 * stage_sum.preprocess_ms / stage_sum.total_ms,
-              100.0 * stage_sum.static_temporal_ms / stage_sum.total_ms, 100.0 * stage_sum.detect_ms / stage_sum.total_ms,
-              100.0 * stage_sum.static_stereo_ms / stage_sum.total_ms, 100.0 * stage_sum.target_ms / stage_sum.total_ms);
+  std::printf(
+      "profile (share of wall time): preprocess %.0f %%, KLT frame to frame + RANSAC %.0f %%, FAST grid "
+      "%.0f %%, stereo KLT + RANSAC %.0f %%, target %.0f %%\n",
+      100.0 * stage_sum.preprocess_ms / stage_sum.total_ms, 100.0 * stage_sum.static_temporal_ms / stage_sum.total_ms,
+      100.0 * stage_sum.detect_ms / stage_sum.total_ms, 100.0 * stage_sum.static_stereo_ms / stage_sum.total_ms,
+      100.0 * stage_sum.target_ms / stage_sum.total_ms);
   if (box) std::printf("target features per frame (cam0, ORB in the box): mean %.1f\n", figures.mean_target_per_frame);
   std::printf("static features per frame (cam0): min %d after the first, mean %.1f\n", figures.min_static_per_frame,
               figures.mean_static_per_frame);

@@ -13,8 +13,7 @@ struct Box {
 
   /// True if (u, v) lies inside the box grown by `margin` pixels on every side.
   bool contains(double u, double v, double margin = 0.0) const {
-    return u >= x_min - margin && u <= x_min + width + margin && v >= y_min - margin &&
-           v <= y_min + height + margin;
+    return u >= x_min - margin && u <= x_min + width + margin && v >= y_min - margin && v <= y_min + height + margin;
   }
   double center_u() const { return x_min + 0.5 * width; }
   double center_v() const { return y_min + 0.5 * height; }

@@ -4,14 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
-
-#include <Eigen/Geometry>
-#include <opencv2/video/tracking.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "common/frontend/grid_detector.h"
 
@@ -29,15 +27,15 @@ void check_image(const cv::Mat& image, const CameraModel& cam, const std::string
   }
   const CameraCalibration& c = cam.calibration();
   if (image.cols != c.width || image.rows != c.height) {
-    throw std::invalid_argument("FeatureTracker: " + name + " image is " + size_text(image) +
-                                ", its calibration is " + std::to_string(c.width) + "x" + std::to_string(c.height));
+    throw std::invalid_argument("FeatureTracker: " + name + " image is " + size_text(image) + ", its calibration is " +
+                                std::to_string(c.width) + "x" + std::to_string(c.height));
   }
 }
 
 void check_box(const std::optional<Box>& box, const std::string& name) {
   if (!box) return;
-  const bool finite = std::isfinite(box->x_min) && std::isfinite(box->y_min) && std::isfinite(box->width) &&
-                      std::isfinite(box->height);
+  const bool finite =
+      std::isfinite(box->x_min) && std::isfinite(box->y_min) && std::isfinite(box->width) && std::isfinite(box->height);
   if (!finite || box->width < 0.0 || box->height < 0.0) {
     throw std::invalid_argument("FeatureTracker: " + name + " box [" + std::to_string(box->x_min) + ", " +
                                 std::to_string(box->y_min) + ", " + std::to_string(box->width) + ", " +
@@ -171,15 +169,11 @@ void FeatureTracker::match_static_stereo(const std::optional<Box>& box_right) {
   // retrying every left-only track each frame cost ~2 ms per EuRoC pair for
   // ~8 % more stereo observations (mostly points the right camera cannot
   // see).
-  std::set<int64_t> paired;
-  for (const Point& p : right) {
-    if (left_of.count(p.id) != 0) paired.insert(p.id);
-  }
-  std::vector<Point> unpaired;
+  std::vector<Point> fresh;
   for (const Point& p : left) {
-    if (paired.count(p.id) == 0 && p.id >= first_new_id_) unpaired.push_back(p);
+    if (p.id >= first_new_id_) fresh.push_back(p);
   }
-  std::vector<Point> found = klt(pyramid_[0], 1, pyramid_[1], unpaired, box_right);
+  std::vector<Point> found = klt(pyramid_[0], 1, pyramid_[1], fresh, box_right);
   right.insert(right.end(), found.begin(), found.end());
 
   // One RANSAC over every stereo pair, continuing and new.
@@ -234,8 +228,8 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
     for (const TargetPoint& t : prev) prev_desc.push_back(t.descriptor);
     const double max_motion2 = o.max_motion_px * o.max_motion_px;
     const auto matches = match_descriptors(cur_desc[c], prev_desc, o.max_hamming, o.match_ratio, [&](int i, int j) {
-      const cv::Point2f d = cur[c][static_cast<std::size_t>(i)].point.pixel -
-                            (prev[static_cast<std::size_t>(j)].point.pixel + shift);
+      const cv::Point2f d =
+          cur[c][static_cast<std::size_t>(i)].point.pixel - (prev[static_cast<std::size_t>(j)].point.pixel + shift);
       return d.dot(d) <= max_motion2;
     });
     std::vector<Eigen::Vector2d> a, b;
@@ -246,7 +240,9 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
     const int cam = static_cast<int>(c);
     const std::vector<bool> in = ransac_.inliers(a, b, focal(cam, cam));
     for (std::size_t k = 0; k < matches.size(); ++k) {
-      if (in[k]) cur[c][static_cast<std::size_t>(matches[k].first)].point.id = prev[static_cast<std::size_t>(matches[k].second)].point.id;
+      if (in[k])
+        cur[c][static_cast<std::size_t>(matches[k].first)].point.id =
+            prev[static_cast<std::size_t>(matches[k].second)].point.id;
     }
   }
 
@@ -388,9 +384,8 @@ CameraFrame FeatureTracker::track(int64_t utime, const cv::Mat& left, const cv::
     };
     for (const Point& p : static_[c]) add(p, false);
     for (const TargetPoint& t : target_[c]) add(t.point, true);
-    std::sort(obs.begin(), obs.end(), [](const FeatureObservation& a, const FeatureObservation& b) {
-      return a.feature_id < b.feature_id;
-    });
+    std::sort(obs.begin(), obs.end(),
+              [](const FeatureObservation& a, const FeatureObservation& b) { return a.feature_id < b.feature_id; });
     frame.observations.insert(frame.observations.end(), obs.begin(), obs.end());
   }
 

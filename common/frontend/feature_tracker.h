@@ -15,13 +15,12 @@
 // Track ids: stable across frames, unique within a run, the same in both
 // cameras for a stereo point. No LCM here.
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <random>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera/camera_model.h"
 #include "common/frontend/box.h"
@@ -61,9 +60,6 @@ class FeatureTracker {
                     std::optional<Box> box_right);
 
   int num_cameras() const { return static_cast<int>(cameras_.size()); }
-  const std::vector<CameraModel>& cameras() const { return cameras_; }
-  /// Target points remembered for loop closure.
-  std::size_t stored_target_points() const { return store_.size(); }
   /// Target tracks that got an old id back by descriptor (loop closures).
   int64_t loop_closures() const { return loop_closures_; }
   const TrackerTiming& last_timing() const { return timing_; }
@@ -89,8 +85,8 @@ class FeatureTracker {
   void track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes);
   /// KLT from one pyramid to another; keeps points that converge inside
   /// `to_cam`'s image, outside `to_box`, with an undistortable pixel.
-  std::vector<Point> klt(const std::vector<cv::Mat>& from_pyr, int to_cam, const std::vector<cv::Mat>& to_pyr, const std::vector<Point>& points,
-                         const std::optional<Box>& to_box) const;
+  std::vector<Point> klt(const std::vector<cv::Mat>& from_pyr, int to_cam, const std::vector<cv::Mat>& to_pyr,
+                         const std::vector<Point>& points, const std::optional<Box>& to_box) const;
   double focal(int cam_a, int cam_b) const;
 
   FeatureTrackerOptions options_;
@@ -100,7 +96,7 @@ class FeatureTracker {
   TargetPointStore store_;
 
   int64_t next_id_{0};
-  int64_t first_new_id_{0};
+  int64_t first_new_id_{0};  // ids from here on were detected this frame
   int64_t frame_index_{0};
   int64_t last_utime_{0};
   int64_t loop_closures_{0};

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -55,9 +54,8 @@ std::vector<cv::Point2f> detect_grid_fast(const cv::Mat& image, const std::vecto
       const cv::Rect roi(x0 - kFastRadius, y0 - kFastRadius, x1 - x0 + 2 * kFastRadius, y1 - y0 + 2 * kFastRadius);
       std::vector<cv::KeyPoint> kps;
       cv::FAST(image(roi), kps, o.fast_threshold, /*nonmaxSuppression=*/true);
-      std::sort(kps.begin(), kps.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
-        return a.response > b.response;
-      });
+      std::sort(kps.begin(), kps.end(),
+                [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
       int added = 0;
       for (const cv::KeyPoint& kp : kps) {
         if (added >= need) break;

@@ -4,10 +4,9 @@
 // its strongest corners, so features spread over the whole image instead of
 // piling up on the most textured patch. No LCM here.
 
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "common/frontend/box.h"
 #include "common/frontend/tracker_options.h"

@@ -9,7 +9,8 @@ namespace vimot::frontend {
 
 int hamming_distance(const Descriptor& a, const Descriptor& b) {
   int d = 0;
-  for (int k = 0; k < 4; ++k) d += __builtin_popcountll(a[static_cast<std::size_t>(k)] ^ b[static_cast<std::size_t>(k)]);
+  for (int k = 0; k < 4; ++k)
+    d += __builtin_popcountll(a[static_cast<std::size_t>(k)] ^ b[static_cast<std::size_t>(k)]);
   return d;
 }
 
@@ -29,10 +30,9 @@ std::vector<OrbFeature> OrbBoxDetector::detect(const cv::Mat& image, const Box& 
                           static_cast<int>(std::ceil(box.width)) + 1, static_cast<int>(std::ceil(box.height)) + 1);
   const cv::Rect inner = box_rect & image_rect;
   if (inner.area() <= 0) return {};
-  const cv::Rect roi =
-      cv::Rect(inner.x - patch_radius_, inner.y - patch_radius_, inner.width + 2 * patch_radius_,
-               inner.height + 2 * patch_radius_) &
-      image_rect;
+  const cv::Rect roi = cv::Rect(inner.x - patch_radius_, inner.y - patch_radius_, inner.width + 2 * patch_radius_,
+                                inner.height + 2 * patch_radius_) &
+                       image_rect;
   cv::Mat mask(roi.size(), CV_8UC1, cv::Scalar(0));
   mask(cv::Rect(inner.x - roi.x, inner.y - roi.y, inner.width, inner.height)).setTo(255);
   std::vector<cv::KeyPoint> kps;
@@ -51,9 +51,8 @@ std::vector<OrbFeature> OrbBoxDetector::detect(const cv::Mat& image, const Box& 
   return out;
 }
 
-std::vector<std::pair<int, int>> match_descriptors(const std::vector<Descriptor>& a,
-                                                   const std::vector<Descriptor>& b, int max_distance,
-                                                   double ratio,
+std::vector<std::pair<int, int>> match_descriptors(const std::vector<Descriptor>& a, const std::vector<Descriptor>& b,
+                                                   int max_distance, double ratio,
                                                    const std::function<bool(int, int)>& allowed) {
   const int na = static_cast<int>(a.size()), nb = static_cast<int>(b.size());
   constexpr int kNone = std::numeric_limits<int>::max();

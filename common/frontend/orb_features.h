@@ -7,11 +7,10 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <utility>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
+#include <utility>
+#include <vector>
 
 #include "common/frontend/box.h"
 #include "common/frontend/tracker_options.h"
@@ -45,9 +44,8 @@ class OrbBoxDetector {
 /// Pairs (i, j) of a[i] and b[j] that are each other's nearest descriptor
 /// among the pairs `allowed(i, j)` admits, at distance <= max_distance, and
 /// clearly nearer than a's second-nearest (best < ratio * second).
-std::vector<std::pair<int, int>> match_descriptors(const std::vector<Descriptor>& a,
-                                                   const std::vector<Descriptor>& b, int max_distance,
-                                                   double ratio,
+std::vector<std::pair<int, int>> match_descriptors(const std::vector<Descriptor>& a, const std::vector<Descriptor>& b,
+                                                   int max_distance, double ratio,
                                                    const std::function<bool(int, int)>& allowed);
 
 }  // namespace vimot::frontend

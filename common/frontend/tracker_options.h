@@ -22,9 +22,9 @@ namespace vimot::frontend {
 
 /// FAST on a grid + pyramidal KLT (environment features).
 struct StaticTrackOptions {
-  bool equalize{true};         // histogram-equalise each image first (camera gain differences)
-  int num_features{200};       // wanted per camera; FAST tops the left image up to this
-  int grid_cols{8};            // detection grid: each cell gets num_features / cells
+  bool equalize{true};    // histogram-equalise each image first (camera gain differences)
+  int num_features{200};  // wanted per camera; FAST tops the left image up to this
+  int grid_cols{8};       // detection grid: each cell gets num_features / cells
   int grid_rows{5};
   int fast_threshold{15};      // FAST intensity threshold (grey levels)
   double min_distance_px{15};  // no new corner this close to a tracked one
@@ -32,31 +32,31 @@ struct StaticTrackOptions {
   int klt_window_px{15};       // KLT window side (odd)
   int klt_pyramid_levels{3};   // levels above the full image
   int klt_max_iterations{20};
-  double klt_epsilon{0.03};    // px, KLT stop criterion
+  double klt_epsilon{0.03};  // px, KLT stop criterion
   void validate() const;
 };
 
 /// ORB inside the target box (target features).
 struct TargetTrackOptions {
-  int num_features{80};                 // ORB keypoints per camera in the box
-  int orb_fast_threshold{10};           // lower than static: a box is small
+  int num_features{80};        // ORB keypoints per camera in the box
+  int orb_fast_threshold{10};  // lower than static: a box is small
   int orb_levels{4};
   double orb_scale_factor{1.2};
-  int max_hamming{60};                  // of 256 bits: a frame-to-frame / stereo match
-  double match_ratio{0.8};              // best / second-best distance (Lowe)
-  double max_motion_px{80.0};           // frame to frame, after the box's own motion
-  int loop_closure_max_hamming{40};     // stricter: no geometry checks a re-identification
-  int max_stored_points{500};           // descriptors kept for loop closure (oldest dropped)
+  int max_hamming{60};               // of 256 bits: a frame-to-frame / stereo match
+  double match_ratio{0.8};           // best / second-best distance (Lowe)
+  double max_motion_px{80.0};        // frame to frame, after the box's own motion
+  int loop_closure_max_hamming{40};  // stricter: no geometry checks a re-identification
+  int max_stored_points{500};        // descriptors kept for loop closure (oldest dropped)
   void validate() const;
 };
 
 /// 8-point RANSAC on the fundamental matrix of undistorted points.
 struct RansacOptions {
-  double threshold_px{1.0};    // Sampson distance, converted to normalized units by the focal length
-  double confidence{0.99};     // stop once an all-inlier sample is this likely to have been drawn
+  double threshold_px{1.0};  // Sampson distance, converted to normalized units by the focal length
+  double confidence{0.99};   // stop once an all-inlier sample is this likely to have been drawn
   int max_iterations{200};
-  int min_points{10};          // below this no model is fitted and every match is kept
-  uint64_t seed{1};            // the sampling is deterministic for a seed
+  int min_points{10};  // below this no model is fitted and every match is kept
+  uint64_t seed{1};    // the sampling is deterministic for a seed
   void validate() const;
 };
 

@@ -82,8 +82,7 @@ TrackingFigures TrackingStats::figures() const {
   if (!static_per_frame_.empty()) {
     f.mean_static_per_frame = std::accumulate(static_per_frame_.begin(), static_per_frame_.end(), 0.0) /
                               static_cast<double>(static_per_frame_.size());
-    f.mean_target_per_frame =
-        static_cast<double>(target_observations_) / static_cast<double>(static_per_frame_.size());
+    f.mean_target_per_frame = static_cast<double>(target_observations_) / static_cast<double>(static_per_frame_.size());
   }
   std::vector<double> lengths;
   for (const auto& [id, n] : track_length_) lengths.push_back(n);

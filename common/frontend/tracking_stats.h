@@ -4,11 +4,10 @@
 // static features per frame, track length, and the stereo epipolar error of
 // the undistorted points against the calibrated extrinsics. No LCM here.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/camera/camera_model.h"
 #include "common/types/sensor_data.h"

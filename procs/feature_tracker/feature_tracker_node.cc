@@ -29,9 +29,8 @@ FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& c
   }
   FeatureTrackerNodeOptions o;
   o.tracker = frontend::FeatureTrackerOptions::from_config(cfg, "tracker");
-  const Config calib = cfg.has("calibration_file")
-                           ? Config::load_file(cfg.resolve_path(cfg.get<std::string>("calibration_file")))
-                           : cfg;
+  const Config calib =
+      cfg.has("calibration_file") ? Config::load_file(cfg.resolve_path(cfg.get<std::string>("calibration_file"))) : cfg;
   const std::string mode = cfg.get_or<std::string>("mode", "stereo");
   if (mode != "stereo" && mode != "mono") cfg.fail("mode", "must be 'stereo' or 'mono', got '" + mode + "'");
   o.cameras.push_back(camera_from_config(calib.sub("cameras.cam0")));

@@ -14,11 +14,10 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "common/camera/camera_model.h"
 #include "common/frontend/box.h"

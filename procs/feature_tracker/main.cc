@@ -46,10 +46,9 @@ int run(int argc, const char* const* argv) {
       node.on_image(1, m.utime, vimot::image_from_lcm(m));
     });
   }
-  process.subscribe<vimot::target_box_t>(process.channel("target_box", "TARGET_BOX"),
-                                         [&](const vimot::target_box_t& m) {
-                                           node.on_box(m.camera_id, m.utime, box_of(m));
-                                         });
+  process.subscribe<vimot::target_box_t>(
+      process.channel("target_box", "TARGET_BOX"),
+      [&](const vimot::target_box_t& m) { node.on_box(m.camera_id, m.utime, box_of(m)); });
   const int status = process.run();
   vimot::log_info("tracked ", node.frames_tracked(), " frames, dropped ", node.images_dropped(), " images, ",
                   node.errors(), " errors");

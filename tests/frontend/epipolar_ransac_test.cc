@@ -1,16 +1,14 @@
 // EpipolarRansac against two-view truth: points of a random 3D scene seen
 // from two known poses (the epipolar constraint holds exactly), with pixel
 // noise and injected outliers whose indices the test knows.
-#include <catch2/catch.hpp>
+#include "common/frontend/epipolar_ransac.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 #include <vector>
-
-#include <Eigen/Geometry>
-
-#include "common/frontend/epipolar_ransac.h"
 
 using namespace vimot::frontend;
 
@@ -95,9 +93,9 @@ TEST_CASE("RANSAC rejects injected outliers and keeps the inliers") {
     double outliers;
   };
   // Temporal-like small motion, stereo-like pure baseline, and a larger move.
-  for (const Case& c : {Case{0.01, Eigen::Vector3d(0.05, 0.0, 0.02), 0.2},
-                        Case{0.0, Eigen::Vector3d(-0.11, 0.0, 0.0), 0.3},
-                        Case{0.2, Eigen::Vector3d(0.4, 0.1, -0.2), 0.4}}) {
+  for (const Case& c :
+       {Case{0.01, Eigen::Vector3d(0.05, 0.0, 0.02), 0.2}, Case{0.0, Eigen::Vector3d(-0.11, 0.0, 0.0), 0.3},
+        Case{0.2, Eigen::Vector3d(0.4, 0.1, -0.2), 0.4}}) {
     const TwoViews v = make_views(200, c.angle, c.t, 0.3, c.outliers, 7);
     const std::vector<bool> in = ransac.inliers(v.a, v.b, kFocal);
     // An outlier moved along its epipolar line obeys the geometry and no

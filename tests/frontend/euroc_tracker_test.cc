@@ -5,14 +5,12 @@
 // it the executable exits with kSkip, which ctest reports as skipped.
 #define CATCH_CONFIG_RUNNER
 #include <catch2/catch.hpp>
-
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <string>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "common/camera/camera_model.h"
 #include "common/frontend/asl_stereo_folder.h"

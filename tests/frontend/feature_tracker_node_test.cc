@@ -1,14 +1,14 @@
 // FeatureTrackerNode without a network: stereo pairing by utime, dropped
 // unpaired and late images, wrong-size images as counted errors, target
 // boxes by utime, mono; and image_t -> cv::Mat for the process.
-#include <catch2/catch.hpp>
+#include "procs/feature_tracker/feature_tracker_node.h"
 
+#include <catch2/catch.hpp>
 #include <string>
 #include <vector>
 
 #include "common/config/config.h"
 #include "common/process/image_conversion.h"
-#include "procs/feature_tracker/feature_tracker_node.h"
 #include "tests/frontend/synthetic_images.h"
 
 using namespace vimot;
@@ -139,10 +139,12 @@ TEST_CASE("FeatureTrackerNodeOptions reads config/feature_tracker.yaml and refus
                            "/config/euroc_stereo.yaml\nmode: mono\nnode: {box_max_age: 1}\n";
   CHECK_THROWS_WITH(FeatureTrackerNodeOptions::from_config(Config::from_string(text, "ft.yaml")),
                     Catch::Contains("node.box_max_age") && Catch::Contains("unknown"));
-  CHECK(FeatureTrackerNodeOptions::from_config(
-            Config::from_string("calibration_file: " + std::string(VIMOT_SOURCE_DIR) + "/config/euroc_stereo.yaml\n"
-                                "mode: mono\n", "ft.yaml"))
-            .cameras.size() == 1);
+  CHECK(
+      FeatureTrackerNodeOptions::from_config(Config::from_string("calibration_file: " + std::string(VIMOT_SOURCE_DIR) +
+                                                                     "/config/euroc_stereo.yaml\n"
+                                                                     "mode: mono\n",
+                                                                 "ft.yaml"))
+          .cameras.size() == 1);
 }
 
 TEST_CASE("image_from_lcm copies a grey image row by row and refuses what it cannot read") {

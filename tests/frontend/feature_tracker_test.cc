@@ -3,19 +3,18 @@
 // (equidistant) camera from known poses, so every tracked pixel has an
 // exact true correspondence; and a textured target patch pasted at known
 // places for the box, ORB and loop-closure behaviour.
-#include <catch2/catch.hpp>
+#include "common/frontend/feature_tracker.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
-
 #include "common/config/config.h"
-#include "common/frontend/feature_tracker.h"
 #include "common/frontend/tracking_stats.h"
 #include "tests/frontend/synthetic_images.h"
 
@@ -169,7 +168,9 @@ cv::Mat scene(const cv::Mat& background, const cv::Mat& patch, std::optional<cv:
   return img;
 }
 
-Box box_at(cv::Point at) { return Box{static_cast<double>(at.x), static_cast<double>(at.y), kPatchW - 1.0, kPatchH - 1.0}; }
+Box box_at(cv::Point at) {
+  return Box{static_cast<double>(at.x), static_cast<double>(at.y), kPatchW - 1.0, kPatchH - 1.0};
+}
 
 }  // namespace
 
@@ -219,8 +220,8 @@ TEST_CASE("a target that leaves and comes back gets its old ids back (target loo
   const CameraFrame f0 = tracker.track(0, scene(background, patch, a), cv::Mat(), box_at(a), std::nullopt);
   // Gone for three frames: no target, no box.
   for (int k = 1; k <= 3; ++k) {
-    const CameraFrame gone = tracker.track(k * 50000, scene(background, patch, std::nullopt), cv::Mat(), std::nullopt,
-                                           std::nullopt);
+    const CameraFrame gone =
+        tracker.track(k * 50000, scene(background, patch, std::nullopt), cv::Mat(), std::nullopt, std::nullopt);
     for (const FeatureObservation& o : gone.observations) CHECK_FALSE(o.is_target);
   }
   CHECK(tracker.loop_closures() == 0);
@@ -261,8 +262,11 @@ TEST_CASE("the tracker rejects bad input with a message and stays usable") {
              Catch::Contains("320x240") && Catch::Contains("640x480"));
   cv::Mat colour;
   cv::cvtColor(image, colour, cv::COLOR_GRAY2BGR);
-  CHECK_THAT(message([&] { stereo.track(0, colour, image, std::nullopt, std::nullopt); }), Catch::Contains("8-bit grey"));
-  CHECK_THAT(message([&] { stereo.track(0, image, image, Box{1.0, 2.0, std::nan(""), 3.0}, std::nullopt); }),
+  CHECK_THAT(message([&] { stereo.track(0, colour, image, std::nullopt, std::nullopt); }),
+             Catch::Contains("8-bit grey"));
+  CHECK_THAT(message([&] {
+               stereo.track(0, image, image, Box{1.0, 2.0, std::nan(""), 3.0}, std::nullopt);
+             }),
              Catch::Contains("left box"));
   CHECK(stereo.track(10, image, image, std::nullopt, std::nullopt).observations.size() > 100);
   CHECK_THAT(message([&] { stereo.track(10, image, image, std::nullopt, std::nullopt); }),

@@ -4,12 +4,11 @@
 // scenes), a textured plane rendered through a calibrated camera (exact
 // pixel correspondences between any two poses), and simple pinhole cameras.
 
-#include <cstdint>
-#include <random>
-
 #include <Eigen/Core>
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "common/camera/camera_model.h"
 

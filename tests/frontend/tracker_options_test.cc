@@ -1,11 +1,11 @@
 // FeatureTrackerOptions::from_config: the shipped config reads, a
 // misspelt key or a bad value is refused naming the file and the key.
-#include <catch2/catch.hpp>
+#include "common/frontend/tracker_options.h"
 
+#include <catch2/catch.hpp>
 #include <string>
 
 #include "common/config/config.h"
-#include "common/frontend/tracker_options.h"
 
 using namespace vimot;
 using frontend::FeatureTrackerOptions;
@@ -37,14 +37,15 @@ TEST_CASE("config/feature_tracker.yaml gives the built-in defaults") {
 
 TEST_CASE("tracker options: values are read, unknown keys and bad values refused") {
   const FeatureTrackerOptions o = FeatureTrackerOptions::from_config(
-      Config::from_string("tracker:\n  static: {num_features: 120, klt_window_px: 11}\n  ransac: {threshold_px: 0.5}\n"),
+      Config::from_string(
+          "tracker:\n  static: {num_features: 120, klt_window_px: 11}\n  ransac: {threshold_px: 0.5}\n"),
       "tracker");
   CHECK(o.static_tracks.num_features == 120);
   CHECK(o.static_tracks.klt_window_px == 11);
   CHECK(o.ransac.threshold_px == 0.5);
-  CHECK_THAT(error_of("tracker:\n  static: {num_feature: 120}\n"),
-             Catch::Contains("tracker.static.num_feature") && Catch::Contains("unknown") &&
-                 Catch::Contains("tracker.yaml"));
+  CHECK_THAT(error_of("tracker:\n  static: {num_feature: 120}\n"), Catch::Contains("tracker.static.num_feature") &&
+                                                                       Catch::Contains("unknown") &&
+                                                                       Catch::Contains("tracker.yaml"));
   CHECK_THAT(error_of("tracker:\n  stereo: {}\n"), Catch::Contains("tracker.stereo") && Catch::Contains("unknown"));
   CHECK_THAT(error_of("tracker:\n  static: {klt_window_px: 14}\n"), Catch::Contains("klt_window_px"));
   CHECK_THAT(error_of("tracker:\n  ransac: {min_points: 7}\n"), Catch::Contains("min_points"));
