@@ -15,6 +15,7 @@ constexpr std::size_t kMaxStoredBoxes = 16;
 
 FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& cfg) {
   const std::vector<std::string> allowed{"calibration_file", "mode", "tracker", "node", "channels", "comment"};
+  const std::vector<std::string> node_keys{"max_pending_images", "box_max_age_s", "wait_for_box"};
   for (const std::string& k : cfg.keys()) {
     if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
       cfg.fail(k, "is unknown (expected calibration_file, mode, tracker, node, channels, comment)");
@@ -22,8 +23,8 @@ FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& c
   }
   if (cfg.has("node")) {
     for (const std::string& k : cfg.sub("node").keys()) {
-      if (k != "max_pending_images" && k != "box_max_age_s") {
-        cfg.fail("node." + k, "is unknown (expected max_pending_images, box_max_age_s)");
+      if (std::find(node_keys.begin(), node_keys.end(), k) == node_keys.end()) {
+        cfg.fail("node." + k, "is unknown (expected max_pending_images, box_max_age_s, wait_for_box)");
       }
     }
   }
@@ -37,6 +38,7 @@ FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& c
   if (mode == "stereo") o.cameras.push_back(camera_from_config(calib.sub("cameras.cam1")));
   o.max_pending_images = cfg.get_or<int>("node.max_pending_images", o.max_pending_images);
   if (o.max_pending_images < 1) cfg.fail("node.max_pending_images", "must be >= 1");
+  o.wait_for_box = cfg.get_or<bool>("node.wait_for_box", o.wait_for_box);
   o.box_max_age_s = cfg.get_or<double>("node.box_max_age_s", o.box_max_age_s);
   if (o.box_max_age_s < 0.0) cfg.fail("node.box_max_age_s", "must be >= 0");
   return o;
@@ -68,12 +70,13 @@ void FeatureTrackerNode::on_box(int camera_id, int64_t utime, std::optional<fron
   if (box && !(std::isfinite(box->x_min) && std::isfinite(box->y_min) && std::isfinite(box->width) &&
                std::isfinite(box->height) && box->width >= 0.0 && box->height >= 0.0)) {
     error("target box of camera " + std::to_string(camera_id) + " at utime " + std::to_string(utime) +
-          " is not finite or has a negative size: ignored");
-    return;
+          " is not finite or has a negative size: taken as no box");
+    box.reset();
   }
   auto& boxes = boxes_[camera_id];
   boxes[utime] = box;
   while (boxes.size() > kMaxStoredBoxes) boxes.erase(boxes.begin());
+  release_ready();
 }
 
 std::optional<frontend::Box> FeatureTrackerNode::box_for(int camera_id, int64_t utime) const {
@@ -103,7 +106,7 @@ void FeatureTrackerNode::on_image(int camera_id, int64_t utime, const cv::Mat& i
     return;
   }
   if (!stereo()) {
-    process(utime, image, cv::Mat());
+    frame_ready(utime, image, cv::Mat());
     return;
   }
   auto& mine = pending_[camera_id];
@@ -134,9 +137,44 @@ void FeatureTrackerNode::on_image(int camera_id, int64_t utime, const cv::Mat& i
     }
   }
   if (camera_id == 0) {
-    process(utime, image, partner_image);
+    frame_ready(utime, image, partner_image);
   } else {
-    process(utime, partner_image, image);
+    frame_ready(utime, partner_image, image);
+  }
+}
+
+void FeatureTrackerNode::frame_ready(int64_t utime, const cv::Mat& left, const cv::Mat& right) {
+  if (!options_.wait_for_box) {
+    process(utime, left, right);
+    return;
+  }
+  ready_.emplace(utime, std::make_pair(left, right));
+  release_ready();
+}
+
+void FeatureTrackerNode::release_ready() {
+  // A frame waits for its boxes; once a later frame is complete too, the
+  // boxes of the earlier one are taken as missing (the box source skipped
+  // it) so a silent box channel delays the output by one frame, no more.
+  while (!ready_.empty()) {
+    const auto it = ready_.begin();
+    bool boxes_in = true;
+    for (std::size_t c = 0; c < options_.cameras.size(); ++c) boxes_in = boxes_in && boxes_[c].count(it->first) != 0;
+    if (!boxes_in && ready_.size() < 2) return;
+    const auto [left, right] = it->second;
+    const int64_t utime = it->first;
+    ready_.erase(it);
+    process(utime, left, right);
+  }
+}
+
+void FeatureTrackerNode::flush() {
+  while (!ready_.empty()) {
+    const auto it = ready_.begin();
+    const auto [left, right] = it->second;
+    const int64_t utime = it->first;
+    ready_.erase(it);
+    process(utime, left, right);
   }
 }
 

@@ -8,8 +8,11 @@
 // have arrived; images older than a tracked frame that never found their
 // partner are dropped (counted), as are images at or before the last
 // tracked utime. Boxes: the latest box of the camera at or before the
-// frame's utime and at most box_max_age_s older (a box message arriving
-// after its image is too late for it).
+// frame's utime and at most box_max_age_s older. With wait_for_box a
+// complete frame is held until every camera's box of its utime has arrived
+// (or a later frame is complete), so a box published after its images is
+// still used and a live run equals a replay; without it a box arriving after
+// its images is too late for them.
 
 #include <cstdint>
 #include <functional>
@@ -17,6 +20,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/camera/camera_model.h"
@@ -38,11 +42,15 @@ struct FeatureTrackerNodeOptions {
   int max_pending_images{4};
   /// A box older than this (s) than the image is not used.
   double box_max_age_s{0.2};
+  /// Hold each frame for its boxes (a box source runs: mask filter, the
+  /// simulator's truth box); false: track as soon as the images are there.
+  bool wait_for_box{false};
 
   /// From a feature tracker config (config/feature_tracker.yaml):
   /// calibration_file (cameras.cam0/cam1, relative to the file), mode
   /// (stereo | mono), tracker (FeatureTrackerOptions), node
-  /// (max_pending_images, box_max_age_s); `channels` is the process's.
+  /// (max_pending_images, box_max_age_s, wait_for_box); `channels` is the
+  /// process's.
   /// Throws ConfigError naming the key for a bad or unknown key.
   static FeatureTrackerNodeOptions from_config(const Config& cfg);
 };
@@ -58,6 +66,8 @@ class FeatureTrackerNode {
   void on_image(int camera_id, int64_t utime, const cv::Mat& image);
   /// The target box of a camera at an image's utime; nullopt: no valid box.
   void on_box(int camera_id, int64_t utime, std::optional<frontend::Box> box);
+  /// Tracks every frame still waiting for its boxes (end of input).
+  void flush();
 
   bool stereo() const { return options_.cameras.size() == 2; }
   int64_t frames_tracked() const { return frames_tracked_; }
@@ -66,6 +76,8 @@ class FeatureTrackerNode {
   const frontend::FeatureTracker& tracker() const { return tracker_; }
 
  private:
+  void frame_ready(int64_t utime, const cv::Mat& left, const cv::Mat& right);
+  void release_ready();
   void process(int64_t utime, const cv::Mat& left, const cv::Mat& right);
   std::optional<frontend::Box> box_for(int camera_id, int64_t utime) const;
   void drop(const std::string& why);
@@ -77,6 +89,7 @@ class FeatureTrackerNode {
   EventCallback on_event_;
   std::map<int64_t, cv::Mat> pending_[2];
   std::map<int64_t, std::optional<frontend::Box>> boxes_[2];
+  std::map<int64_t, std::pair<cv::Mat, cv::Mat>> ready_;  // complete frames waiting for boxes
   int64_t last_utime_{-1};
   int64_t frames_tracked_{0};
   int64_t images_dropped_{0};

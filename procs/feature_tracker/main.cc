@@ -50,6 +50,7 @@ int run(int argc, const char* const* argv) {
       process.channel("target_box", "TARGET_BOX"),
       [&](const vimot::target_box_t& m) { node.on_box(m.camera_id, m.utime, box_of(m)); });
   const int status = process.run();
+  node.flush();
   vimot::log_info("tracked ", node.frames_tracked(), " frames, dropped ", node.images_dropped(), " images, ",
                   node.errors(), " errors");
   return status;

@@ -129,12 +129,46 @@ TEST_CASE("the node uses each camera's box at or before the frame, and mono trac
   CHECK(node.errors() == 2);
 }
 
+TEST_CASE("with wait_for_box a frame waits for its boxes, or for the next frame when no box comes") {
+  Recorder r;
+  FeatureTrackerNodeOptions o = options(2);
+  o.wait_for_box = true;
+  FeatureTrackerNode node = make_node(o, r);
+  const cv::Mat image = test::make_texture(320, 240, 55, 400);
+  const frontend::Box box{100.0, 60.0, 120.0, 100.0};
+  node.on_image(0, 1000000, image);
+  node.on_image(1, 1000000, image);
+  node.on_box(0, 1000000, box);
+  CHECK(r.frames.empty());  // the right box is still missing
+  node.on_box(1, 1000000, box);
+  REQUIRE(r.frames.size() == 1);
+  int targets[2] = {0, 0};
+  for (const FeatureObservation& f : r.frames[0].observations) targets[f.camera_id] += f.is_target ? 1 : 0;
+  CHECK(targets[0] > 0);
+  CHECK(targets[1] > 0);
+  // No boxes at 2 s (the 1 s box is older than box_max_age_s): that frame
+  // goes out when the 3 s frame is complete, without a box.
+  node.on_image(0, 2000000, image);
+  node.on_image(1, 2000000, image);
+  CHECK(r.frames.size() == 1);
+  node.on_image(0, 3000000, image);
+  node.on_image(1, 3000000, image);
+  REQUIRE(r.frames.size() == 2);
+  CHECK(r.frames[1].utime == 2000000);
+  for (const FeatureObservation& f : r.frames[1].observations) CHECK_FALSE(f.is_target);
+  node.flush();
+  REQUIRE(r.frames.size() == 3);
+  CHECK(r.frames[2].utime == 3000000);
+  CHECK(node.errors() == 0);
+}
+
 TEST_CASE("FeatureTrackerNodeOptions reads config/feature_tracker.yaml and refuses unknown keys") {
   const Config cfg = Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/feature_tracker.yaml");
   const FeatureTrackerNodeOptions o = FeatureTrackerNodeOptions::from_config(cfg);
   REQUIRE(o.cameras.size() == 2);
   CHECK(o.cameras[0].width == 752);
   CHECK(o.max_pending_images == 4);
+  CHECK_FALSE(o.wait_for_box);
   const std::string text = "calibration_file: " + std::string(VIMOT_SOURCE_DIR) +
                            "/config/euroc_stereo.yaml\nmode: mono\nnode: {box_max_age: 1}\n";
   CHECK_THROWS_WITH(FeatureTrackerNodeOptions::from_config(Config::from_string(text, "ft.yaml")),
