@@ -55,10 +55,13 @@ void validate(const CameraCalibration& c) {
                                   " must be positive, got " + fmt(c.intrinsics(i)));
     }
   }
-  const char* kDistortionNames[] = {"k1", "k2", "p1", "p2"};
+  const char* kRadtanNames[] = {"k1", "k2", "p1", "p2"};
+  const char* kEquidistantNames[] = {"k1", "k2", "k3", "k4"};
+  const bool radtan = c.distortion_model == DistortionModel::kRadialTangential;
   for (int i = 0; i < 4; ++i) {
     if (!std::isfinite(c.distortion(i))) {
-      throw std::invalid_argument(std::string("camera calibration: distortion ") + kDistortionNames[i] +
+      throw std::invalid_argument(std::string("camera calibration: distortion ") +
+                                  (radtan ? kRadtanNames[i] : kEquidistantNames[i]) +
                                   " must be finite, got " + fmt(c.distortion(i)));
     }
   }
@@ -76,33 +79,75 @@ void validate(const CameraCalibration& c) {
 
 CameraModel::CameraModel(const CameraCalibration& calibration) : calib_(calibration) { validate(calib_); }
 
+namespace {
+
+// Below this radius the equidistant factor θd / r equals 1 + (k1 - 1/3) r² to
+// within r⁴ < 1e-32: the closed form would divide 0 by 0 at the centre.
+constexpr double kEquidistantSmallRadius = 1e-8;
+
+// Equidistant model: x_d = s(r) x with s = θd(θ(r)) / r, θ = atan r.
+// Returns s and (ds/dr) / r, which is finite at r = 0.
+void equidistant_scale(const Eigen::Vector4d& k, double r, double* s, double* ds_dr_over_r) {
+  if (r < kEquidistantSmallRadius) {
+    *s = 1.0;
+    *ds_dr_over_r = 2.0 * (k(0) - 1.0 / 3.0);
+    return;
+  }
+  const double theta = std::atan(r);
+  const double t2 = theta * theta;
+  const double poly = 1.0 + t2 * (k(0) + t2 * (k(1) + t2 * (k(2) + t2 * k(3))));
+  const double theta_d = theta * poly;
+  // dθd/dθ = 1 + 3 k1 θ² + 5 k2 θ⁴ + 7 k3 θ⁶ + 9 k4 θ⁸; dθ/dr = 1 / (1 + r²).
+  const double dtheta_d = 1.0 + t2 * (3.0 * k(0) + t2 * (5.0 * k(1) + t2 * (7.0 * k(2) + t2 * 9.0 * k(3))));
+  const double dtheta_d_dr = dtheta_d / (1.0 + r * r);
+  *s = theta_d / r;
+  *ds_dr_over_r = (dtheta_d_dr * r - theta_d) / (r * r * r);
+}
+
+}  // namespace
+
 Eigen::Vector2d CameraModel::distort(const Eigen::Vector2d& normalized) const {
   const double x = normalized.x(), y = normalized.y();
-  const double k1 = calib_.distortion(0), k2 = calib_.distortion(1);
-  const double p1 = calib_.distortion(2), p2 = calib_.distortion(3);
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
-  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  double xd = 0.0, yd = 0.0;
+  if (calib_.distortion_model == DistortionModel::kEquidistant) {
+    double s = 0.0, unused = 0.0;
+    equidistant_scale(calib_.distortion, normalized.norm(), &s, &unused);
+    xd = s * x;
+    yd = s * y;
+  } else {
+    const double k1 = calib_.distortion(0), k2 = calib_.distortion(1);
+    const double p1 = calib_.distortion(2), p2 = calib_.distortion(3);
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  }
   return Eigen::Vector2d(calib_.intrinsics(0) * xd + calib_.intrinsics(2),
                          calib_.intrinsics(1) * yd + calib_.intrinsics(3));
 }
 
 Eigen::Matrix2d CameraModel::distort_jacobian(const Eigen::Vector2d& normalized) const {
-  const double x = normalized.x(), y = normalized.y();
-  const double k1 = calib_.distortion(0), k2 = calib_.distortion(1);
-  const double p1 = calib_.distortion(2), p2 = calib_.distortion(3);
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
-  // d radial / d(x, y) = (k1 + 2 k2 r²) d r² / d(x, y), with d r² = (2x, 2y).
-  const double dradial_dr2 = k1 + 2.0 * k2 * r2;
-  const double dradial_dx = 2.0 * x * dradial_dr2;
-  const double dradial_dy = 2.0 * y * dradial_dr2;
   Eigen::Matrix2d J;
-  J(0, 0) = radial + x * dradial_dx + 2.0 * p1 * y + 6.0 * p2 * x;
-  J(0, 1) = x * dradial_dy + 2.0 * p1 * x + 2.0 * p2 * y;
-  J(1, 0) = y * dradial_dx + 2.0 * p1 * x + 2.0 * p2 * y;
-  J(1, 1) = radial + y * dradial_dy + 6.0 * p1 * y + 2.0 * p2 * x;
+  if (calib_.distortion_model == DistortionModel::kEquidistant) {
+    // d(s x)/dx = s I + x (ds/dr) dr/dx = s I + (ds/dr / r) x xᵀ.
+    double s = 0.0, ds_dr_over_r = 0.0;
+    equidistant_scale(calib_.distortion, normalized.norm(), &s, &ds_dr_over_r);
+    J = s * Eigen::Matrix2d::Identity() + ds_dr_over_r * normalized * normalized.transpose();
+  } else {
+    const double x = normalized.x(), y = normalized.y();
+    const double k1 = calib_.distortion(0), k2 = calib_.distortion(1);
+    const double p1 = calib_.distortion(2), p2 = calib_.distortion(3);
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+    // d radial / d(x, y) = (k1 + 2 k2 r²) d r² / d(x, y), with d r² = (2x, 2y).
+    const double dradial_dr2 = k1 + 2.0 * k2 * r2;
+    const double dradial_dx = 2.0 * x * dradial_dr2;
+    const double dradial_dy = 2.0 * y * dradial_dr2;
+    J(0, 0) = radial + x * dradial_dx + 2.0 * p1 * y + 6.0 * p2 * x;
+    J(0, 1) = x * dradial_dy + 2.0 * p1 * x + 2.0 * p2 * y;
+    J(1, 0) = y * dradial_dx + 2.0 * p1 * x + 2.0 * p2 * y;
+    J(1, 1) = radial + y * dradial_dy + 6.0 * p1 * y + 2.0 * p2 * x;
+  }
   J.row(0) *= calib_.intrinsics(0);
   J.row(1) *= calib_.intrinsics(1);
   return J;
@@ -112,6 +157,7 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& pixel) const {
   if (!pixel.allFinite()) {
     throw std::runtime_error("CameraModel::undistort: pixel " + fmt_pixel(pixel) + " is not finite");
   }
+  if (calib_.distortion_model == DistortionModel::kEquidistant) return undistort_equidistant(pixel);
   // The distorted normalized point is the first guess: distortion moves a
   // point by a fraction of its radius, so it starts on the right branch.
   Eigen::Vector2d x((pixel.x() - calib_.intrinsics(2)) / calib_.intrinsics(0),
@@ -153,6 +199,36 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& pixel) const {
                            " camera, or beyond the range where the distortion model is invertible)");
 }
 
+Eigen::Vector2d CameraModel::undistort_equidistant(const Eigen::Vector2d& pixel) const {
+  // The model is radial, so inverting it is one equation in the angle θ off
+  // the optical axis: θd = θ (1 + k1 θ² + k2 θ⁴ + k3 θ⁶ + k4 θ⁸), solved by
+  // Newton from θ = θd; then r = tan θ. (Newton on x itself would chase r to
+  // infinity near 90° where tan θ blows up.)
+  const Eigen::Vector2d xd((pixel.x() - calib_.intrinsics(2)) / calib_.intrinsics(0),
+                           (pixel.y() - calib_.intrinsics(3)) / calib_.intrinsics(1));
+  const double theta_d = xd.norm();
+  if (theta_d < kEquidistantSmallRadius) return xd;
+  const Eigen::Vector4d& k = calib_.distortion;
+  double theta = theta_d;
+  for (int iter = 0; iter < kMaxUndistortIterations; ++iter) {
+    const double t2 = theta * theta;
+    const double f = theta * (1.0 + t2 * (k(0) + t2 * (k(1) + t2 * (k(2) + t2 * k(3))))) - theta_d;
+    const double df = 1.0 + t2 * (3.0 * k(0) + t2 * (5.0 * k(1) + t2 * (7.0 * k(2) + t2 * 9.0 * k(3))));
+    // dθd/dθ <= 0: past the angle where the lens model turns back, no ray.
+    if (!(df > 0.0)) break;
+    const double step = f / df;
+    theta -= step;
+    if (std::abs(step) < kUndistortStepTolerance) {
+      // A ray at 90° or more from the axis has no point on the plane z = 1.
+      if (!(theta > 0.0 && theta < 0.5 * M_PI)) break;
+      return xd * (std::tan(theta) / theta_d);
+    }
+  }
+  throw std::runtime_error("CameraModel::undistort: no ray in front of the equidistant camera for pixel " +
+                           fmt_pixel(pixel) + " (the model does not invert there, or the ray is 90 degrees or more "
+                           "off the optical axis)");
+}
+
 bool CameraModel::in_image(const Eigen::Vector2d& pixel, double border) const {
   // Pixel centres are at integer coordinates 0 .. width-1 (OpenCV), so a
   // pixel inside [border, width-1-border] can be sampled, also bilinearly,
@@ -171,12 +247,16 @@ CameraCalibration camera_from_config(const Config& node) {
       node.fail("camera_model", "must be 'pinhole', got '" + model + "'");
     }
   }
+  CameraCalibration c;
   const std::string distortion_model = node.get<std::string>("distortion_model");
-  if (distortion_model != "radial-tangential") {
-    node.fail("distortion_model", "must be 'radial-tangential', got '" + distortion_model + "'");
+  if (distortion_model == "radial-tangential") {
+    c.distortion_model = DistortionModel::kRadialTangential;
+  } else if (distortion_model == "equidistant") {
+    c.distortion_model = DistortionModel::kEquidistant;
+  } else {
+    node.fail("distortion_model", "must be 'radial-tangential' or 'equidistant', got '" + distortion_model + "'");
   }
 
-  CameraCalibration c;
   const Eigen::Vector2d resolution = node.get_vec<2>("resolution");
   if (resolution.x() != std::floor(resolution.x()) || resolution.y() != std::floor(resolution.y())) {
     node.fail("resolution", "must be two integers [width, height], got [" + fmt(resolution.x()) + ", " +

@@ -20,7 +20,7 @@ std::string num(double v) {
 
 bool same_camera(const CameraCalibration& a, const CameraCalibration& b) {
   return a.width == b.width && a.height == b.height && a.intrinsics == b.intrinsics &&
-         a.distortion == b.distortion && a.R_ItoC == b.R_ItoC && a.p_IinC == b.p_IinC;
+         a.distortion_model == b.distortion_model && a.distortion == b.distortion && a.R_ItoC == b.R_ItoC && a.p_IinC == b.p_IinC;
 }
 
 }  // namespace

@@ -214,6 +214,82 @@ TEST_CASE("undistort agrees with OpenCV undistortPoints where OpenCV converges")
   }
 }
 
+// A fisheye lens on a 752x480 sensor (Kalibr equidistant coefficients of a
+// T265-class lens); its image corners lie 74 degrees off the axis.
+CameraCalibration fisheye_lens() {
+  CameraCalibration c;
+  c.width = 752;
+  c.height = 480;
+  c.intrinsics << 350.0, 351.0, 380.0, 242.0;
+  c.distortion_model = DistortionModel::kEquidistant;
+  c.distortion << -0.0073, 0.0434, -0.0405, 0.0076;
+  return c;
+}
+
+TEST_CASE("equidistant distort equals OpenCV fisheye::distortPoints") {
+  const CameraCalibration calib = fisheye_lens();
+  const CameraModel cam(calib);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> uni(-2.5, 2.5);
+  std::vector<cv::Point2d> normalized;
+  for (int i = 0; i < 2000; ++i) normalized.emplace_back(uni(rng), uni(rng));
+  normalized.emplace_back(0.0, 0.0);     // the centre, where θd / r is 0 / 0
+  normalized.emplace_back(1e-10, 0.0);   // inside the small-radius branch
+  std::vector<cv::Point2d> cv_pixels;
+  cv::fisheye::distortPoints(normalized, cv_pixels, camera_matrix(calib), dist_coeffs(calib));
+  double max_error = 0.0;
+  for (std::size_t i = 0; i < normalized.size(); ++i) {
+    const Eigen::Vector2d p = cam.distort(Eigen::Vector2d(normalized[i].x, normalized[i].y));
+    max_error = std::max(max_error, (p - Eigen::Vector2d(cv_pixels[i].x, cv_pixels[i].y)).norm());
+  }
+  CHECK(max_error < 1e-9);
+}
+
+TEST_CASE("equidistant distort_jacobian equals central finite differences") {
+  const CameraModel cam(fisheye_lens());
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uni(-2.5, 2.5);
+  const double h = 1e-6;
+  std::vector<Eigen::Vector2d> points{Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(3e-9, -2e-9)};
+  for (int i = 0; i < 200; ++i) points.emplace_back(uni(rng), uni(rng));
+  for (const Eigen::Vector2d& x : points) {
+    Eigen::Matrix2d numeric;
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector2d dx = h * Eigen::Vector2d::Unit(k);
+      numeric.col(k) = (cam.distort(x + dx) - cam.distort(x - dx)) / (2.0 * h);
+    }
+    const Eigen::Matrix2d J = cam.distort_jacobian(x);
+    INFO("x = " << x.transpose() << "\nanalytic\n" << J << "\nnumeric\n" << numeric);
+    CHECK((J - numeric).norm() < 1e-6 * J.norm());
+  }
+}
+
+TEST_CASE("equidistant undistort inverts distort and agrees with OpenCV fisheye::undistortPoints") {
+  const CameraCalibration calib = fisheye_lens();
+  const CameraModel cam(calib);
+  const std::vector<Eigen::Vector2d> grid = image_grid(calib, 8.0);
+  std::vector<cv::Point2d> pixels;
+  double max_pixel_error = 0.0;
+  for (const Eigen::Vector2d& p : grid) {
+    pixels.emplace_back(p.x(), p.y());
+    max_pixel_error = std::max(max_pixel_error, (cam.distort(cam.undistort(p)) - p).norm());
+  }
+  CHECK(max_pixel_error < 1e-9);
+  std::vector<cv::Point2d> cv_normalized;
+  cv::fisheye::undistortPoints(pixels, cv_normalized, camera_matrix(calib), dist_coeffs(calib), cv::noArray(),
+                               cv::noArray(),
+                               cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
+  double max_error = 0.0;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const Eigen::Vector2d n = cam.undistort(grid[i]);
+    max_error = std::max(max_error, (n - Eigen::Vector2d(cv_normalized[i].x, cv_normalized[i].y)).norm());
+  }
+  CHECK(max_error < 1e-8);
+  // 2.2 rad (126 degrees) off the axis: no point on the plane z = 1.
+  const std::string msg = message_of<std::runtime_error>([&] { cam.undistort(Eigen::Vector2d(380.0 + 770.0, 242.0)); });
+  CHECK_THAT(msg, Catch::Contains("1150") && Catch::Contains("90 degrees"));
+}
+
 TEST_CASE("undistort throws naming the pixel where the model has no inverse") {
   // Pure barrel distortion k1 = -0.5 folds over at r = 1/sqrt(1.5): distorted
   // radii beyond 0.544 (218 pixels here) are the image of no ray.
@@ -366,11 +442,18 @@ TEST_CASE("camera_from_config reads the ASL layout and rejects what it cannot mo
   CHECK(c.height == 480);
   CHECK(c.p_IinC.isApprox(Eigen::Vector3d(-0.1, 0.0, 0.0)));
 
-  SECTION("another distortion model") {
+  CHECK(c.distortion_model == DistortionModel::kRadialTangential);
+
+  SECTION("the equidistant model with its four coefficients") {
     const std::string text = replace(kAslCamera, "radial-tangential", "equidistant");
+    const CameraCalibration e = camera_from_config(Config::from_string(text, "asl.yaml"));
+    CHECK(e.distortion_model == DistortionModel::kEquidistant);
+    CHECK(e.distortion(3) == 1.76187114e-05);
+  }
+  SECTION("another distortion model") {
+    const std::string text = replace(kAslCamera, "radial-tangential", "fov");
     const std::string msg = message_of<ConfigError>([&] { camera_from_config(Config::from_string(text, "asl.yaml")); });
-    CHECK_THAT(msg, Catch::Contains("equidistant") && Catch::Contains("distortion_model") &&
-                        Catch::Contains("asl.yaml"));
+    CHECK_THAT(msg, Catch::Contains("fov") && Catch::Contains("distortion_model") && Catch::Contains("asl.yaml"));
   }
   SECTION("another projection model") {
     const std::string text = replace(kAslCamera, "pinhole", "omni");

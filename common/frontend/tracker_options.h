@@ -1,0 +1,76 @@
+#pragma once
+// Options of the feature tracker (common/frontend), read from config in one
+// place. Keys under the section (config/feature_tracker.yaml, `tracker:`):
+//   static:  equalize, num_features, grid_cols, grid_rows, fast_threshold,
+//            min_distance_px, border_px, klt_window_px, klt_pyramid_levels,
+//            klt_max_iterations, klt_epsilon
+//   target:  num_features, orb_fast_threshold, orb_levels, orb_scale_factor,
+//            max_hamming, match_ratio, max_motion_px, loop_closure_max_hamming,
+//            max_stored_points
+//   ransac:  threshold_px, confidence, max_iterations, min_points, seed
+// Every key is optional; an unknown key is an error naming it. Meanings and
+// defaults: docs/feature_tracker.md.
+
+#include <cstdint>
+#include <string>
+
+namespace vimot {
+class Config;
+}
+
+namespace vimot::frontend {
+
+/// FAST on a grid + pyramidal KLT (environment features).
+struct StaticTrackOptions {
+  bool equalize{true};    // histogram-equalise each image first (camera gain differences)
+  int num_features{200};  // wanted per camera; FAST tops the left image up to this
+  int grid_cols{8};       // detection grid: each cell gets num_features / cells
+  int grid_rows{5};
+  int fast_threshold{15};      // FAST intensity threshold (grey levels)
+  double min_distance_px{15};  // no new corner this close to a tracked one
+  int border_px{8};            // corners and tracks keep this far from the image edge
+  int klt_window_px{15};       // KLT window side (odd)
+  int klt_pyramid_levels{3};   // levels above the full image
+  int klt_max_iterations{20};
+  double klt_epsilon{0.03};  // px, KLT stop criterion
+  void validate() const;
+};
+
+/// ORB inside the target box (target features).
+struct TargetTrackOptions {
+  int num_features{80};        // ORB keypoints per camera in the box
+  int orb_fast_threshold{10};  // lower than static: a box is small
+  int orb_levels{4};
+  double orb_scale_factor{1.2};
+  int max_hamming{60};               // of 256 bits: a frame-to-frame / stereo match
+  double match_ratio{0.8};           // best / second-best distance (Lowe)
+  double max_motion_px{80.0};        // frame to frame, after the box's own motion
+  int loop_closure_max_hamming{40};  // stricter: no geometry checks a re-identification
+  int max_stored_points{500};        // descriptors kept for loop closure (oldest dropped)
+  void validate() const;
+};
+
+/// 8-point RANSAC on the fundamental matrix of undistorted points.
+struct RansacOptions {
+  double threshold_px{1.0};  // Sampson distance, converted to normalized units by the focal length
+  double confidence{0.99};   // stop once an all-inlier sample is this likely to have been drawn
+  int max_iterations{200};
+  int min_points{10};  // below this no model is fitted and every match is kept
+  uint64_t seed{1};    // the sampling is deterministic for a seed
+  void validate() const;
+};
+
+struct FeatureTrackerOptions {
+  StaticTrackOptions static_tracks;
+  TargetTrackOptions target;
+  RansacOptions ransac;
+
+  /// Throws std::invalid_argument naming the first invalid option.
+  void validate() const;
+
+  /// Reads `section` of `cfg` (absent keys keep the defaults); throws
+  /// ConfigError naming the file and key for a bad value or unknown key.
+  static FeatureTrackerOptions from_config(const Config& cfg, const std::string& section);
+};
+
+}  // namespace vimot::frontend

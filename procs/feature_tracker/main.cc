@@ -1,0 +1,63 @@
+// feature_tracker: the visual front end as an LCM process. Subscribes
+// CAM_LEFT / CAM_RIGHT (image_t; mono: CAM_LEFT only) and the target box
+// channel (target_box_t per camera), publishes FEATURES (features_t) at the
+// images' utime. All logic is in FeatureTrackerNode / common/frontend; this
+// file moves bytes.
+
+#include <optional>
+
+#include "common/process/image_conversion.h"
+#include "common/process/lcm_conversions.h"
+#include "common/process/node_runner.h"
+#include "common/process/process.h"
+#include "procs/feature_tracker/feature_tracker_node.h"
+#include "vimot/image_t.hpp"
+#include "vimot/target_box_t.hpp"
+
+namespace {
+
+// The filtered box when the box filter holds one, else this frame's raw
+// detection, else none (every feature of that image static).
+std::optional<vimot::frontend::Box> box_of(const vimot::target_box_t& m) {
+  const double* b = m.filtered_valid ? m.filtered_box : (m.raw_valid ? m.raw_box : nullptr);
+  if (b == nullptr) return std::nullopt;
+  return vimot::frontend::Box{b[0], b[1], b[2], b[3]};
+}
+
+int run(int argc, const char* const* argv) {
+  vimot::Process process("feature_tracker",
+                         "Visual front end: CAM_LEFT / CAM_RIGHT images (+ target boxes) in, FEATURES out.\n"
+                         "Configured by config/feature_tracker.yaml (calibration file, stereo or mono,\n"
+                         "tracker options, channels).",
+                         /*config_required=*/true);
+  if (!process.init(argc, argv)) return 0;
+
+  const vimot::FeatureTrackerNodeOptions options = vimot::FeatureTrackerNodeOptions::from_config(process.config());
+  const std::string features_channel = process.channel("features", "FEATURES");
+  vimot::FeatureTrackerNode node(
+      options, [&](const vimot::CameraFrame& f) { process.publish(features_channel, vimot::to_lcm(f)); },
+      vimot::report_events_to(process));
+
+  process.subscribe<vimot::image_t>(process.channel("left", "CAM_LEFT"), [&](const vimot::image_t& m) {
+    node.on_image(0, m.utime, vimot::grey_from_lcm_image(m));
+  });
+  if (node.stereo()) {
+    process.subscribe<vimot::image_t>(process.channel("right", "CAM_RIGHT"), [&](const vimot::image_t& m) {
+      node.on_image(1, m.utime, vimot::grey_from_lcm_image(m));
+    });
+  }
+  process.subscribe<vimot::target_box_t>(
+      process.channel("target_box", "TARGET_BOX"),
+      [&](const vimot::target_box_t& m) { node.on_box(m.camera_id, m.utime, box_of(m)); });
+  const int status = process.run();
+  node.flush();
+  vimot::log_info("tracked ", node.frames_tracked(), " frames, dropped ", node.images_dropped(), " images, ",
+                  node.errors(), " errors");
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return vimot::run_process_main([&] { return run(argc, argv); });
+}

@@ -1,0 +1,53 @@
+// FeatureTrackerOptions::from_config: the shipped config reads, a
+// misspelt key or a bad value is refused naming the file and the key.
+#include "common/frontend/tracker_options.h"
+
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "common/config/config.h"
+
+using namespace vimot;
+using frontend::FeatureTrackerOptions;
+
+namespace {
+std::string error_of(const std::string& yaml) {
+  try {
+    FeatureTrackerOptions::from_config(Config::from_string(yaml, "tracker.yaml"), "tracker");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+}  // namespace
+
+TEST_CASE("config/feature_tracker.yaml gives the built-in defaults") {
+  const Config cfg = Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/feature_tracker.yaml");
+  const FeatureTrackerOptions o = FeatureTrackerOptions::from_config(cfg, "tracker");
+  const FeatureTrackerOptions d;
+  CHECK(o.static_tracks.num_features == d.static_tracks.num_features);
+  CHECK(o.static_tracks.klt_window_px == d.static_tracks.klt_window_px);
+  CHECK(o.static_tracks.klt_epsilon == d.static_tracks.klt_epsilon);
+  CHECK(o.static_tracks.equalize == d.static_tracks.equalize);
+  CHECK(o.target.max_hamming == d.target.max_hamming);
+  CHECK(o.target.loop_closure_max_hamming == d.target.loop_closure_max_hamming);
+  CHECK(o.ransac.threshold_px == d.ransac.threshold_px);
+  CHECK(o.ransac.max_iterations == d.ransac.max_iterations);
+}
+
+TEST_CASE("tracker options: values are read, unknown keys and bad values refused") {
+  const FeatureTrackerOptions o = FeatureTrackerOptions::from_config(
+      Config::from_string(
+          "tracker:\n  static: {num_features: 120, klt_window_px: 11}\n  ransac: {threshold_px: 0.5}\n"),
+      "tracker");
+  CHECK(o.static_tracks.num_features == 120);
+  CHECK(o.static_tracks.klt_window_px == 11);
+  CHECK(o.ransac.threshold_px == 0.5);
+  CHECK_THAT(error_of("tracker:\n  static: {num_feature: 120}\n"), Catch::Contains("tracker.static.num_feature") &&
+                                                                       Catch::Contains("unknown") &&
+                                                                       Catch::Contains("tracker.yaml"));
+  CHECK_THAT(error_of("tracker:\n  stereo: {}\n"), Catch::Contains("tracker.stereo") && Catch::Contains("unknown"));
+  CHECK_THAT(error_of("tracker:\n  static: {klt_window_px: 14}\n"), Catch::Contains("klt_window_px"));
+  CHECK_THAT(error_of("tracker:\n  ransac: {min_points: 7}\n"), Catch::Contains("min_points"));
+  CHECK_THAT(error_of("tracker:\n  target: {match_ratio: 1.5}\n"), Catch::Contains("match_ratio"));
+}
