@@ -20,14 +20,15 @@ using estimator::VioEstimator;
 
 void play_simulator(sim::Simulator& sim, estimator::VioEstimator& estimator,
                     const std::function<void(const GroundTruth&)>& on_truth,
-                    const std::function<bool(const CameraFrame&)>& on_frame) {
+                    const std::function<bool(const CameraFrame&)>& on_frame, PixelFrontEnd* pixels) {
   while (std::optional<sim::SimEvent> ev = sim.next()) {
     if (const auto* imu = std::get_if<ImuData>(&*ev)) {
       estimator.feed_imu(*imu);
     } else if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
       on_truth(*gt);
-    } else if (!on_frame(std::get<CameraFrame>(*ev))) {
-      return;
+    } else {
+      const CameraFrame& simulated = std::get<CameraFrame>(*ev);
+      if (!on_frame(pixels ? pixels->frame(simulated.utime) : simulated)) return;
     }
   }
 }
@@ -39,6 +40,8 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
   cfg.ground_truth_events = true;
   sim::Simulator sim(cfg);
   VioEstimator est(options);
+  std::optional<PixelFrontEnd> pixels;
+  if (ro.pixels) pixels.emplace(sim, *ro.pixels);
 
   SimRunResult r;
   r.sim_seed = cfg.seed;
@@ -118,7 +121,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
     if (ro.on_frame) ro.on_frame(est, s);
     if (ro.keep_samples) r.samples.push_back(s);
     return true;
-  });
+  }, pixels ? &*pixels : nullptr);
   if (ro.progress) ro.progress(1.0);
 
   r.errors = errors.summary();
@@ -225,6 +228,7 @@ std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const esti
         cfg.seed = seed;
         SimRunOptions ro;
         ro.keep_samples = o.keep_samples;
+        ro.pixels = o.pixels;
         ro.progress = fr;
         results[static_cast<std::size_t>(i)] = run_vio_on_sim(cfg, options, perturb_seed_of(o, seed), ro);
       },

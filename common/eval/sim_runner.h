@@ -22,12 +22,15 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/estimator/vio_estimator.h"
 #include "common/eval/alignment.h"
 #include "common/eval/metrics.h"
+#include "common/eval/pixel_frontend.h"
+#include "common/frontend/tracker_options.h"
 #include "common/sim/sim_config.h"
 #include "common/sim/simulator.h"
 
@@ -51,6 +54,9 @@ struct FrameSample {
 
 struct SimRunOptions {
   bool keep_samples{true};  // false: only the summary (long Monte Carlo)
+  /// Set: frames from pixels — rendered images through the feature tracker
+  /// with these options (PixelFrontEnd) instead of the simulated tracks.
+  std::optional<frontend::FeatureTrackerOptions> pixels;
   /// Fraction of the run's camera frames done, after every frame (called
   /// on the thread running the simulation).
   std::function<void(double)> progress;
@@ -86,10 +92,11 @@ struct SimRunResult {
 /// go to `estimator`, ground truth to `on_truth`, camera frames to
 /// `on_frame`, which returns false to stop. At equal utime the simulator
 /// emits IMU, GroundTruth, CameraFrame, so a frame's truth (if any) has
-/// arrived before it.
+/// arrived before it. With `pixels`, each camera frame is replaced by the
+/// features `pixels` tracks in the images rendered at its utime.
 void play_simulator(sim::Simulator& sim, estimator::VioEstimator& estimator,
                     const std::function<void(const GroundTruth&)>& on_truth,
-                    const std::function<bool(const CameraFrame&)>& on_frame);
+                    const std::function<bool(const CameraFrame&)>& on_frame, PixelFrontEnd* pixels = nullptr);
 
 /// One run on `sim_config` (its seed and duration as given).
 SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
@@ -101,6 +108,7 @@ struct MonteCarloOptions {
   int threads{0};                  // 0: std::thread::hardware_concurrency()
   bool perturb{true};              // false: every run starts exactly at the truth
   bool keep_samples{true};
+  std::optional<frontend::FeatureTrackerOptions> pixels;  // as SimRunOptions::pixels
   /// Nonzero: every run uses this perturbation seed (to reproduce one run
   /// of the `vins` process, whose config names its seed).
   uint64_t fixed_perturb_seed{0};

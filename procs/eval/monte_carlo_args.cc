@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <thread>
 
+#include "common/config/config.h"
+
 namespace vimot {
 namespace eval {
 
@@ -15,6 +17,9 @@ void add_monte_carlo_args(ArgParser& args, const std::string& runs_help, const s
                   "perturbation seed of the start for every run instead of one derived from the\n"
                   "simulator seed (e.g. the vins config's init.perturb_seed, to reproduce an LCM\n"
                   "run); 0 = start at the truth");
+  args.add_option("pixels", "FILE",
+                  "frames from pixels: the rendered images through the feature tracker, configured\n"
+                  "by FILE's tracker: section (e.g. config/feature_tracker_sim.yaml), target box = truth");
 }
 
 MonteCarloArgs read_monte_carlo_args(const ArgParser& args) {
@@ -33,6 +38,9 @@ MonteCarloArgs read_monte_carlo_args(const ArgParser& args) {
     const long long p = args.get_int("perturb-seed");
     if (p < 0) throw ArgError("--perturb-seed must be >= 0, got " + args.get("perturb-seed"));
     a.perturb_seed = static_cast<uint64_t>(p);
+  }
+  if (args.given("pixels")) {
+    a.pixels = frontend::FeatureTrackerOptions::from_config(Config::load_file(args.get("pixels")), "tracker");
   }
   return a;
 }

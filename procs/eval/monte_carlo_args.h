@@ -1,13 +1,14 @@
 #pragma once
 // The command-line options every Monte-Carlo evaluation tool shares
 // (vimot-vio-eval, vimot-target-eval, vimot-scale-eval): --runs,
-// --first-seed, --threads, --duration, --perturb-seed, declared and checked
-// in one place.
+// --first-seed, --threads, --duration, --perturb-seed, --pixels, declared
+// and checked in one place.
 
 #include <cstdint>
 #include <optional>
 #include <string>
 
+#include "common/frontend/tracker_options.h"
 #include "common/process/arg_parser.h"
 
 namespace vimot {
@@ -22,6 +23,9 @@ struct MonteCarloArgs {
   int threads{1};                        // --threads 0 resolved to the hardware concurrency
   std::optional<double> duration_s;      // --duration
   std::optional<uint64_t> perturb_seed;  // --perturb-seed (0 = start at the truth)
+  /// --pixels FILE: frames from rendered images through the feature tracker,
+  /// its options from FILE's `tracker:` section (the feature_tracker process's config).
+  std::optional<frontend::FeatureTrackerOptions> pixels;
 };
 
 /// Reads and checks them after ArgParser::parse. Throws ArgError naming the

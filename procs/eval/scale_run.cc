@@ -7,6 +7,7 @@
 #include "common/estimator/initial_estimate.h"
 #include "common/estimator/nav_state_of.h"
 #include "common/eval/sim_runner.h"
+#include "common/eval/pixel_frontend.h"
 #include "common/sim/simulator.h"
 #include "procs/object_tracker/object_tracker_node.h"
 
@@ -25,6 +26,8 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
   r.perturb_seed = perturb_seed;
 
   estimator::VioEstimator est(options.vio);
+  std::optional<PixelFrontEnd> pixels;
+  if (options.pixels) pixels.emplace(sim, *options.pixels);
   const estimator::InitialEstimate x0 = estimator::initial_estimate(sim.initial_state(), options.vio, perturb_seed);
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
   // The tracker's pose of the current frame (the node publishes one per
@@ -90,7 +93,7 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
     node.on_nav_state(nav);
     node.on_object_pose(tracked);
     return true;
-  });
+  }, pixels ? &*pixels : nullptr);
   if (progress) progress(1.0);
   r.vio = vio_errors.summary();
   r.figures = figures.figures();

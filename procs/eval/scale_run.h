@@ -8,9 +8,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 
 #include "common/estimator/vio_estimator.h"
 #include "common/eval/scale_eval.h"
+#include "common/frontend/tracker_options.h"
 #include "common/object/object_tracker.h"
 #include "common/sim/sim_config.h"
 #include "procs/scale_estimator/scale_node.h"
@@ -22,6 +24,9 @@ struct ScaleEvalOptions {
   estimator::VioOptions vio;
   ObjectTrackerOptions tracker;
   ScaleNodeOptions node;
+  /// Set: frames from pixels (common/eval/pixel_frontend.h) instead of the
+  /// simulated tracks.
+  std::optional<frontend::FeatureTrackerOptions> pixels;
 };
 
 /// One run on `sim_config` (mono scenario with a target). perturb_seed 0 =

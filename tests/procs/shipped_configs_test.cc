@@ -34,8 +34,9 @@ void load_with_its_reader(const std::string& name, const std::string& path) {
   if (name == "euroc_stereo.yaml") {
     const estimator::VioOptions o = estimator::VioOptions::from_config(cfg);
     CHECK(o.cameras.size() == 2);
-  } else if (name == "feature_tracker.yaml") {
-    CHECK(FeatureTrackerNodeOptions::from_config(cfg).cameras.size() == 2);
+  } else if (name.rfind("feature_tracker", 0) == 0) {
+    const bool mono = name.find("mono") != std::string::npos;
+    CHECK(FeatureTrackerNodeOptions::from_config(cfg).cameras.size() == (mono ? 1u : 2u));
   } else if (name == "object_tracker.yaml") {
     CHECK(object_tracker_options_from_config(cfg).window_size == 20);
   } else if (name == "scale_estimator.yaml") {

@@ -1,0 +1,38 @@
+#pragma once
+// Feature frames from pixels, offline: the rendered simulator's images of a
+// camera frame (common/sim/renderer.h) through the feature tracker
+// (common/frontend), with the target box the renderer reports as truth —
+// what `vimot-sim --render` → `vimot-feature-tracker` (target box channel
+// TARGET_BOX_TRUTH, node.wait_for_box) computes over LCM, so an evaluator
+// fed by this front end gives the figures of that LCM pipeline.
+
+#include <cstdint>
+#include <optional>
+
+#include "common/frontend/feature_tracker.h"
+#include "common/frontend/tracker_options.h"
+#include "common/sim/renderer.h"
+#include "common/sim/simulator.h"
+#include "common/types/sensor_data.h"
+
+namespace vimot {
+namespace eval {
+
+class PixelFrontEnd {
+ public:
+  /// Renders `sim`'s cameras (which must outlive this) and tracks with
+  /// `options` on the simulator's own calibrations.
+  PixelFrontEnd(const sim::Simulator& sim, const frontend::FeatureTrackerOptions& options);
+
+  /// The tracked features of the images at `utime` (a camera frame's time).
+  CameraFrame frame(int64_t utime);
+
+  const frontend::FeatureTracker& tracker() const { return tracker_; }
+
+ private:
+  sim::Renderer renderer_;
+  frontend::FeatureTracker tracker_;
+};
+
+}  // namespace eval
+}  // namespace vimot
