@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Builds a libFuzzer target (clang, -DVIMOT_FUZZ=ON, its own build folder)
+# and runs it for N seconds at the lowest CPU priority.
+#   scripts/fuzz.sh [SECONDS] [TARGET]      (defaults: 60, fuzz_mip_parser)
+# Seed corpus for fuzz_mip_parser: the real MIP recording in
+# $VIMOT_DATA_DIR/mip cut into 4 KiB slices (small seeds run faster than the
+# whole 369 KB file; together they hold every byte of it).
+# build-fuzz/corpus/<target>; crashes land in build-fuzz/artifacts/.
+set -euo pipefail
+
+SECONDS_TO_RUN=${1:-60}
+TARGET=${2:-fuzz_mip_parser}
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${VIMOT_FUZZ_BUILD:-$ROOT/build-fuzz}
+
+if ! command -v clang++ >/dev/null; then
+  echo "fuzz.sh: clang++ not found (apt-get install clang libclang-rt-14-dev)" >&2
+  exit 1
+fi
+
+if [ ! -f "$BUILD/CMakeCache.txt" ]; then
+  CC=clang CXX=clang++ cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release -DVIMOT_FUZZ=ON -DBUILD_TESTING=OFF
+fi
+nice -n 19 cmake --build "$BUILD" -j2 --target "$TARGET"
+
+CORPUS=$BUILD/corpus/$TARGET
+mkdir -p "$CORPUS" "$BUILD/artifacts"
+if [ "$TARGET" = fuzz_mip_parser ] && [ -z "$(ls -A "$CORPUS")" ]; then
+  RECORDING=${VIMOT_DATA_DIR:-}/mip/mip_data.bin
+  if [ -f "$RECORDING" ]; then
+    split -b 4096 -d -a 3 "$RECORDING" "$CORPUS/slice_"
+  else
+    echo "fuzz.sh: no seed corpus (set VIMOT_DATA_DIR to the shared data folder); starting empty" >&2
+  fi
+fi
+
+nice -n 19 "$BUILD/bin/$TARGET" "$CORPUS" -max_len=1048576 -max_total_time="$SECONDS_TO_RUN" \
+  -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/"
