@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Builds a libFuzzer target (clang, -DVIMOT_FUZZ=ON, its own build folder)
-# and runs it for N seconds at the lowest CPU priority.
+# Builds a libFuzzer target (clang, -DVIMOT_FUZZ=ON, its own build folder),
+# runs it for N seconds at the lowest CPU priority, then reports the line and
+# branch coverage of the parser sources reached by the corpus.
 #   scripts/fuzz.sh [SECONDS] [TARGET]      (defaults: 60, fuzz_mip_parser)
 # Seed corpus for fuzz_mip_parser: the real MIP recording in
 # $VIMOT_DATA_DIR/mip cut into 4 KiB slices (small seeds run faster than the
-# whole 369 KB file; together they hold every byte of it).
-# build-fuzz/corpus/<target>; crashes land in build-fuzz/artifacts/.
+# whole 369 KB file; together they hold every byte of it). The corpus grows
+# in build-fuzz/corpus/<target>; crashes land in build-fuzz/artifacts/.
 set -euo pipefail
 
 SECONDS_TO_RUN=${1:-60}
@@ -21,7 +22,7 @@ fi
 if [ ! -f "$BUILD/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release -DVIMOT_FUZZ=ON -DBUILD_TESTING=OFF
 fi
-nice -n 19 cmake --build "$BUILD" -j2 --target "$TARGET"
+nice -n 19 cmake --build "$BUILD" -j2 --target "$TARGET" "${TARGET}_cov"
 
 CORPUS=$BUILD/corpus/$TARGET
 mkdir -p "$CORPUS" "$BUILD/artifacts"
@@ -36,3 +37,13 @@ fi
 
 nice -n 19 "$BUILD/bin/$TARGET" "$CORPUS" -max_len=1048576 -max_total_time="$SECONDS_TO_RUN" \
   -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/"
+
+# Coverage of the corpus: the uninstrumented-by-sanitizer twin runs every
+# input once and writes a profile.
+if command -v llvm-profdata >/dev/null && command -v llvm-cov >/dev/null; then
+  PROFILE=$BUILD/$TARGET.profraw
+  LLVM_PROFILE_FILE=$PROFILE nice -n 19 "$BUILD/bin/${TARGET}_cov" "$CORPUS" -runs=0 >/dev/null 2>&1
+  llvm-profdata merge -sparse "$PROFILE" -o "$BUILD/$TARGET.profdata"
+  llvm-cov report "$BUILD/bin/${TARGET}_cov" -instr-profile="$BUILD/$TARGET.profdata" \
+    "$ROOT"/drivers/imu_mip/mip_protocol.cc "$ROOT"/drivers/imu_mip/mip_parser.cc "$ROOT"/drivers/imu_mip/mip_messages.cc
+fi
