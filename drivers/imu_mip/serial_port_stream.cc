@@ -1,6 +1,8 @@
 // ByteStream over libserialport (Debian 12: 0.1.1).
 #include <libserialport.h>
 
+#include <algorithm>
+
 #include "drivers/imu_mip/byte_stream.h"
 
 namespace vimot::mip {
@@ -41,7 +43,9 @@ class SerialPortStream : public ByteStream {
   }
 
   std::size_t read(uint8_t* data, std::size_t size, int timeout_ms) override {
-    const sp_return n = sp_blocking_read(port_, data, size, static_cast<unsigned>(timeout_ms));
+    // libserialport's timeout 0 means "wait forever": a zero wait polls instead.
+    const sp_return n = timeout_ms > 0 ? sp_blocking_read(port_, data, size, static_cast<unsigned>(timeout_ms))
+                                       : sp_nonblocking_read(port_, data, size);
     if (n < 0) throw StreamClosed(sp_error_text("read failed on", name_));
     // 0.1.1 reports a hang-up as a timeout; the input queue query fails then.
     if (n == 0 && sp_input_waiting(port_) < 0) throw StreamClosed(sp_error_text("hang-up on", name_));
@@ -49,7 +53,7 @@ class SerialPortStream : public ByteStream {
   }
 
   void write(const uint8_t* data, std::size_t size, int timeout_ms) override {
-    const sp_return n = sp_blocking_write(port_, data, size, static_cast<unsigned>(timeout_ms));
+    const sp_return n = sp_blocking_write(port_, data, size, static_cast<unsigned>(std::max(timeout_ms, 1)));
     if (n < 0) throw StreamClosed(sp_error_text("write failed on", name_));
     if (static_cast<std::size_t>(n) != size) {
       throw StreamClosed("write timed out on '" + name_ + "' (" + std::to_string(n) + " of " +

@@ -161,3 +161,9 @@ TEST_CASE("Bad driver options are refused") {
   o.timestamp_field = 0x0E;
   CHECK_THROWS_WITH(ImuMipDriver(o, nullptr, nullptr, nullptr, nullptr), Catch::Contains("timestamp_field"));
 }
+
+TEST_CASE("Opening an absent device fails with its name, through either byte stream") {
+  CHECK_THROWS_WITH(open_serial_port("/dev/vimot_no_such_port", 115200), Catch::Contains("/dev/vimot_no_such_port"));
+  CHECK_THROWS_WITH(open_tty_fd("/dev/vimot_no_such_port", 115200), Catch::Contains("/dev/vimot_no_such_port"));
+  CHECK_THROWS_WITH(open_tty_fd("/dev/null", 1234), Catch::Contains("unsupported baud rate 1234"));
+}
