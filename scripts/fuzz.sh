@@ -2,7 +2,8 @@
 # Builds a libFuzzer target (clang, -DVIMOT_FUZZ=ON, its own build folder),
 # runs it for N seconds at the lowest CPU priority, then reports the line and
 # branch coverage of the parser sources reached by the corpus.
-#   scripts/fuzz.sh [SECONDS] [TARGET]      (defaults: 60, fuzz_mip_parser)
+#   scripts/fuzz.sh [SECONDS] [TARGET] [LIBFUZZER OPTIONS...]   (defaults: 60, fuzz_mip_parser)
+# e.g. scripts/fuzz.sh 1800 fuzz_mip_parser -len_control=0   (long inputs from the start)
 # Seed corpus for fuzz_mip_parser: the real MIP recording in
 # $VIMOT_DATA_DIR/mip cut into 4 KiB slices (small seeds run faster than the
 # whole 369 KB file; together they hold every byte of it). The corpus grows
@@ -36,7 +37,7 @@ if [ "$TARGET" = fuzz_mip_parser ] && [ -z "$(ls -A "$CORPUS")" ]; then
 fi
 
 nice -n 19 "$BUILD/bin/$TARGET" "$CORPUS" -max_len=1048576 -max_total_time="$SECONDS_TO_RUN" \
-  -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/"
+  -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/" "${@:3}"
 
 # Coverage of the corpus: the uninstrumented-by-sanitizer twin runs every
 # input once and writes a profile.
