@@ -11,8 +11,10 @@
 #include <iterator>
 #include <map>
 
+#include "drivers/imu_mip/imu_mip_driver.h"
 #include "drivers/imu_mip/mip_messages.h"
 #include "drivers/imu_mip/mip_parser.h"
+#include "tests/imu_mip/simulated_mip_device.h"
 
 using namespace vimot::mip;
 
@@ -77,6 +79,40 @@ TEST_CASE("Every packet of the recording decodes; counts per descriptor set as i
   CHECK(samples.front().a_IinI.x() == Approx(0.0174176432 * 9.80665).epsilon(1e-6));
   CHECK(samples.front().a_IinI.z() == Approx(-0.9856400490 * 9.80665).epsilon(1e-6));
   CHECK(samples.front().w_IinI.z() == Approx(-0.0042687873).epsilon(1e-6));
+}
+
+TEST_CASE("The recording streamed by a simulated device through a pty: every sample reaches the driver") {
+  const std::vector<uint8_t> bytes = read_recording();
+  test::SimulatedMipDevice device(test::SimulatedMipDevice::Behaviour{});
+  ImuMipOptions options;
+  options.timestamp_field = kFieldReferenceTime;  // what this device sends
+  options.command_timeout = 1.0;
+  options.stream_timeout = 5.0;
+  std::vector<vimot::ImuData> got;
+  int64_t now = 1'700'000'000'000'000;
+  ImuMipDriver driver(
+      options, [&] { return open_tty_fd(device.slave_path(), 115200); },
+      [&](const vimot::ImuData& imu) { got.push_back(imu); }, [](const std::string&, bool) {},
+      [&] { return now += 100; });  // a host clock that only moves forward
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!driver.streaming() && std::chrono::steady_clock::now() < deadline) driver.step(10);
+  REQUIRE(driver.streaming());
+  device.stream_bytes(bytes);
+  while ((got.size() < 4473 || !device.idle_to_send()) && std::chrono::steady_clock::now() < deadline) driver.step(10);
+
+  REQUIRE(got.size() == 4473);
+  const ImuMipCounters c = driver.counters();
+  CHECK(c.bytes_dropped == 0);
+  CHECK(c.packets_dropped == 0);
+  CHECK(c.samples_without_device_time == 0);
+  CHECK(c.packets_ignored == 8384 - 4473);  // every non-IMU packet (the set-up replies are consumed)
+  double mean_norm = 0.0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    if (i > 0) REQUIRE(got[i].utime > got[i - 1].utime);
+    mean_norm += got[i].a_IinI.norm() / static_cast<double>(got.size());
+  }
+  CHECK(mean_norm == Approx(9.80665).epsilon(0.02));
+  CHECK(got.front().w_IinI.z() == Approx(-0.0042687873).epsilon(1e-6));
 }
 
 int main(int argc, char* argv[]) {

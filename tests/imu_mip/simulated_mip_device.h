@@ -59,7 +59,9 @@ class SimulatedMipDevice {
 
   void plug() {
     std::lock_guard<std::mutex> lock(mutex_);
-    master_ = posix_openpt(O_RDWR | O_NOCTTY);
+    // Non-blocking, so a full pty never blocks this thread while it holds the
+    // lock the test thread (which also runs the reading driver) needs.
+    master_ = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
     if (master_ < 0 || grantpt(master_) != 0 || unlockpt(master_) != 0) throw std::runtime_error("posix_openpt");
     char name[128];
     if (ptsname_r(master_, name, sizeof name) != 0) throw std::runtime_error("ptsname_r");
@@ -92,7 +94,15 @@ class SimulatedMipDevice {
 
   /// Streams n more packets once the driver has resumed the device.
   void stream(int n) { to_send_ += n; }
-  bool idle_to_send() const { return to_send_ == 0; }
+  /// Streams these bytes (e.g. a recording) once resumed, as fast as the pty takes them.
+  void stream_bytes(const std::vector<uint8_t>& bytes) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    raw_.insert(raw_.end(), bytes.begin(), bytes.end());
+  }
+  bool idle_to_send() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return to_send_ == 0 && raw_sent_ == raw_.size();
+  }
 
   std::vector<std::pair<uint8_t, uint8_t>> commands() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -202,6 +212,10 @@ class SimulatedMipDevice {
         while (parser_.next(cmd)) answer(cmd);
       }
       const bool resumed = streaming_ && !format_.empty();
+      if (resumed && raw_sent_ < raw_.size()) {
+        const ssize_t n = ::write(master_, raw_.data() + raw_sent_, std::min<std::size_t>(1024, raw_.size() - raw_sent_));
+        if (n > 0) raw_sent_ += static_cast<std::size_t>(n);
+      }
       if (resumed && to_send_ > 0 && Clock::now() >= next_sample) {
         send_sample(next_k_++);
         --to_send_;
@@ -225,6 +239,8 @@ class SimulatedMipDevice {
   std::vector<uint8_t> format_;
   Sent sent_;
   int next_k_{0};
+  std::vector<uint8_t> raw_;
+  std::size_t raw_sent_{0};
   std::atomic<int> to_send_{0};
   std::atomic<bool> stop_{false};
   std::thread thread_;
