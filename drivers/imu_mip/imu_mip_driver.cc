@@ -21,6 +21,24 @@ int to_ms(double seconds) { return static_cast<int>(std::lround(seconds * 1000.0
 
 }  // namespace
 
+std::vector<std::pair<std::string, int64_t>> named_counters(const ImuMipCounters& c) {
+  return {{"samples", c.samples},
+          {"bytes_in", c.bytes_in},
+          {"packets", c.packets},
+          {"bytes_dropped", c.bytes_dropped},
+          {"packets_dropped", c.packets_dropped},
+          {"checksum_errors", c.checksum_errors},
+          {"malformed_samples", c.malformed_samples},
+          {"packets_ignored", c.packets_ignored},
+          {"samples_without_device_time", c.samples_without_device_time},
+          {"nacks", c.nacks},
+          {"command_timeouts", c.command_timeouts},
+          {"setup_failures", c.setup_failures},
+          {"disconnects", c.disconnects},
+          {"reconnects", c.reconnects},
+          {"time_relocks", c.time_relocks}};
+}
+
 ImuMipDriver::ImuMipDriver(const ImuMipOptions& options, StreamOpener opener, SampleCallback on_sample,
                            EventCallback on_event, HostClock clock)
     : options_(options),

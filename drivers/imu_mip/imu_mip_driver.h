@@ -17,6 +17,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/types/sensor_data.h"
@@ -55,6 +56,9 @@ struct ImuMipCounters {
   int64_t reconnects{0};            // set-ups completed after the first
   int64_t time_relocks{0};          // device clock restarts / host clock steps
 };
+
+/// The counters as (snake_case name, value) for the heartbeat, in a fixed order.
+std::vector<std::pair<std::string, int64_t>> named_counters(const ImuMipCounters& c);
 
 class ImuMipDriver {
  public:

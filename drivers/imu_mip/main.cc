@@ -14,22 +14,7 @@ namespace {
 void report_counters(vimot::Process& process, const vimot::mip::ImuMipCounters& c) {
   process.counters().messages_in = c.packets;
   process.counters().dropped = c.packets_dropped;
-  const std::pair<const char*, int64_t> named[] = {
-      {"bytes_in", c.bytes_in},
-      {"bytes_dropped", c.bytes_dropped},
-      {"packets_dropped", c.packets_dropped},
-      {"checksum_errors", c.checksum_errors},
-      {"malformed_samples", c.malformed_samples},
-      {"packets_ignored", c.packets_ignored},
-      {"samples_without_device_time", c.samples_without_device_time},
-      {"nacks", c.nacks},
-      {"command_timeouts", c.command_timeouts},
-      {"setup_failures", c.setup_failures},
-      {"disconnects", c.disconnects},
-      {"reconnects", c.reconnects},
-      {"time_relocks", c.time_relocks},
-  };
-  for (const auto& [name, value] : named) process.set_counter(name, value);
+  for (const auto& [name, value] : vimot::mip::named_counters(c)) process.set_counter(name, value);
 }
 
 int run(int argc, const char* const* argv) {
