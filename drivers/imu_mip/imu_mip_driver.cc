@@ -54,6 +54,10 @@ ImuMipDriver::ImuMipDriver(const ImuMipOptions& options, StreamOpener opener, Sa
         "ImuMipDriver: rate_hz, command_timeout, stream_timeout must be > 0, command_tries >= 1, "
         "reconnect_interval >= 0");
   }
+  if (options.stream_timeout < 2.0 / options.rate_hz) {
+    throw std::invalid_argument("ImuMipDriver: stream_timeout " + std::to_string(options.stream_timeout) +
+                                " s is under two sample periods at " + std::to_string(options.rate_hz) + " Hz");
+  }
   if (options.timestamp_field != kFieldGpsTimestamp && options.timestamp_field != kFieldReferenceTime) {
     throw std::invalid_argument("ImuMipDriver: timestamp_field must be 0x12 (GPS correlation) or 0xD5 (reference)");
   }

@@ -158,6 +158,9 @@ TEST_CASE("Bad driver options are refused") {
   o.rate_hz = 0.0;
   CHECK_THROWS_WITH(ImuMipDriver(o, nullptr, nullptr, nullptr, nullptr), Catch::Contains("rate_hz"));
   o = ImuMipOptions();
+  o.rate_hz = 1.0;  // a sample per second cannot be watched with a 1 s timeout
+  CHECK_THROWS_WITH(ImuMipDriver(o, nullptr, nullptr, nullptr, nullptr), Catch::Contains("two sample periods"));
+  o = ImuMipOptions();
   o.timestamp_field = 0x0E;
   CHECK_THROWS_WITH(ImuMipDriver(o, nullptr, nullptr, nullptr, nullptr), Catch::Contains("timestamp_field"));
 }
