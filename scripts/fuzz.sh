@@ -36,7 +36,10 @@ if [ "$TARGET" = fuzz_mip_parser ] && [ -z "$(ls -A "$CORPUS")" ]; then
   fi
 fi
 
-nice -n 19 "$BUILD/bin/$TARGET" "$CORPUS" -max_len=1048576 -max_total_time="$SECONDS_TO_RUN" \
+DICT=()
+if [ "$TARGET" = fuzz_mip_parser ]; then DICT=(-dict="$ROOT/drivers/imu_mip/fuzz_mip_parser.dict"); fi
+
+nice -n 19 "$BUILD/bin/$TARGET" "$CORPUS" "${DICT[@]}" -max_len=1048576 -max_total_time="$SECONDS_TO_RUN" \
   -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/" "${@:3}"
 
 # Coverage of the corpus: the uninstrumented-by-sanitizer twin runs every
