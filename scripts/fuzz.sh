@@ -27,13 +27,29 @@ nice -n 19 cmake --build "$BUILD" -j2 --target "$TARGET" "${TARGET}_cov"
 
 CORPUS=$BUILD/corpus/$TARGET
 mkdir -p "$CORPUS" "$BUILD/artifacts"
-if [ "$TARGET" = fuzz_mip_parser ] && [ -z "$(ls -A "$CORPUS")" ]; then
-  RECORDING=${VIMOT_DATA_DIR:-}/mip/mip_data.bin
-  if [ -f "$RECORDING" ]; then
+RECORDING=${VIMOT_DATA_DIR:-}/mip/mip_data.bin
+if [ "$TARGET" = fuzz_mip_parser ] && [ -f "$RECORDING" ]; then
+  if [ -z "$(ls "$CORPUS" | grep '^slice_')" ]; then
     split -b 4096 -d -a 3 "$RECORDING" "$CORPUS/slice_"
-  else
-    echo "fuzz.sh: no seed corpus (set VIMOT_DATA_DIR to the shared data folder); starting empty" >&2
   fi
+  # Seeds for the reframed mode (first byte >= 0x80): the recording's
+  # packets as (set, length, payload) records, 50 per seed.
+  if [ -z "$(ls "$CORPUS" | grep '^reframed_')" ]; then
+    python3 - "$RECORDING" "$CORPUS" <<'PY'
+import sys
+data = open(sys.argv[1], "rb").read()
+records, i = [], 0
+while i + 4 <= len(data) and data[i:i + 2] == b"\x75\x65":
+    n = data[i + 3]
+    records.append(data[i + 2:i + 4 + n])
+    i += 6 + n
+for k in range(0, len(records), 50):
+    with open(f"{sys.argv[2]}/reframed_{k // 50:03d}", "wb") as f:
+        f.write(bytes([0x80 | (k // 50 % 0x80)]) + b"".join(records[k:k + 50]))
+PY
+  fi
+elif [ "$TARGET" = fuzz_mip_parser ] && [ -z "$(ls -A "$CORPUS")" ]; then
+  echo "fuzz.sh: no seed corpus (set VIMOT_DATA_DIR to the shared data folder); starting empty" >&2
 fi
 
 DICT=()

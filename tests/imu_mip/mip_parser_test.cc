@@ -190,6 +190,20 @@ TEST_CASE("IMU decoding: wrong field sizes and NaN are malformed, other packets 
   build({{kFieldScaledAccel, a}, {kFieldScaledGyro, nan_w}});
   CHECK(decode_imu(packet, s, &why) == ImuDecode::kMalformed);
   CHECK_THAT(why, Catch::Contains("gyro"));
+  build({{kFieldScaledAccel, a}, {kFieldScaledGyro, w}, {kFieldReferenceTime, {0, 0, 0, 1}}});
+  CHECK(decode_imu(packet, s, &why) == ImuDecode::kMalformed);
+  CHECK_THAT(why, Catch::Contains("reference timestamp field of 4 bytes"));
+  std::vector<uint8_t> gps;
+  append_f64(gps, std::numeric_limits<double>::infinity());
+  append_u32(gps, 0);
+  build({{kFieldScaledAccel, a}, {kFieldScaledGyro, w}, {kFieldGpsTimestamp, gps}});
+  CHECK(decode_imu(packet, s, &why) == ImuDecode::kMalformed);
+  CHECK_THAT(why, Catch::Contains("GPS timestamp"));
+  std::vector<uint8_t> ref;
+  append_u64(ref, 1'500'000'000);  // 1.5 s in ns; preferred over a GPS field
+  build({{kFieldScaledAccel, a}, {kFieldScaledGyro, w}, {kFieldGpsTimestamp, gps}, {kFieldReferenceTime, ref}});
+  REQUIRE(decode_imu(packet, s) == ImuDecode::kSample);
+  CHECK(*s.device_time == 1.5);
   build({{kFieldScaledAccel, a}, {kFieldScaledGyro, w}});  // no timestamp: a sample without device time
   REQUIRE(decode_imu(packet, s) == ImuDecode::kSample);
   CHECK_FALSE(s.device_time);
