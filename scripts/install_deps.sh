@@ -11,7 +11,7 @@ PACKAGES=(
   libyaml-cpp-dev                                    # configuration files
   default-jdk-headless libjchart2d-java              # lcm-gen --java, lcm-spy plots
   python3 python3-numpy python3-matplotlib           # plotting scripts
-  clang libclang-rt-14-dev                           # libFuzzer targets (VIMOT_FUZZ, docs/fuzzing.md)
+  clang libclang-rt-14-dev llvm                      # scripts/fuzz.sh: libFuzzer, llvm-cov (build option VIMOT_FUZZ)
 )
 
 missing=()

@@ -84,7 +84,10 @@ const std::vector<LcmTypeInfo>& vimot_lcm_types() {
       {"dropped", LcmKind::kInt64},
       {"errors", LcmKind::kInt64},
       {"status", LcmKind::kString},
-      {"last_error", LcmKind::kString}}};
+      {"last_error", LcmKind::kString},
+      {"num_counters", LcmKind::kInt32},
+      {"counter_names", LcmKind::kString, "num_counters"},
+      {"counter_values", LcmKind::kInt64, "num_counters"}}};
   static const LcmStruct image{"image_t", {
       {"utime", LcmKind::kInt64},
       {"width", LcmKind::kInt32},

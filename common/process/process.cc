@@ -86,6 +86,16 @@ void Process::report_dropped(const std::string& why) {
   log_warn("dropped: ", why);
 }
 
+void Process::set_counter(const std::string& name, int64_t value) {
+  for (auto& [n, v] : extra_counters_) {
+    if (n == name) {
+      v = value;
+      return;
+    }
+  }
+  extra_counters_.emplace_back(name, value);
+}
+
 bool Process::stop_requested() const { return stop_requested_ || g_signal_received; }
 
 void Process::publish_heartbeat() {
@@ -100,6 +110,11 @@ void Process::publish_heartbeat() {
   hb.errors = counters_.errors;
   hb.status = counters_.errors > 0 ? "degraded" : "ok";
   hb.last_error = last_error_;
+  hb.num_counters = static_cast<int32_t>(extra_counters_.size());
+  for (const auto& [n, v] : extra_counters_) {
+    hb.counter_names.push_back(n);
+    hb.counter_values.push_back(v);
+  }
   lcm_->publish(config_.get_or<std::string>("channels.heartbeat", "HEARTBEAT"), &hb);
 }
 

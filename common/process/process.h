@@ -16,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
@@ -80,6 +81,11 @@ class Process {
   /// Counts dropped input (late, duplicate, out-of-order) with a reason.
   void report_dropped(const std::string& why);
 
+  /// Sets a process-specific cumulative counter carried by the heartbeat
+  /// (counter_names / counter_values, in first-set order). Call from the
+  /// thread that publishes the heartbeat.
+  void set_counter(const std::string& name, int64_t value);
+
   /// Handles LCM until stop() or a signal; sends a heartbeat every second.
   /// `idle` runs after each handled batch or timeout (e.g. deferred work).
   int run(const std::function<void()>& idle = {});
@@ -100,6 +106,7 @@ class Process {
   std::unique_ptr<lcm::LCM> lcm_;
   ProcessCounters counters_;
   std::string last_error_;
+  std::vector<std::pair<std::string, int64_t>> extra_counters_;
   std::atomic<bool> stop_requested_{false};
 
   // Subscriptions keep their closures alive for the LCM callbacks.

@@ -65,6 +65,9 @@ TEST_CASE("heartbeat carries name and counters") {
     received = true;
   });
   p->report_dropped("test");
+  p->set_counter("bytes_dropped", 5);
+  p->set_counter("reconnects", 1);
+  p->set_counter("bytes_dropped", 7);  // updated in place, order kept
   p->publish_heartbeat();
   while (p->lcm().handleTimeout(10) > 0) {
   }
@@ -73,6 +76,8 @@ TEST_CASE("heartbeat carries name and counters") {
   CHECK(got.dropped == 1);
   CHECK(got.messages_out == 0);  // the heartbeat itself is not counted
   CHECK(got.status == "ok");
+  CHECK(got.counter_names == std::vector<std::string>({"bytes_dropped", "reconnects"}));
+  CHECK(got.counter_values == std::vector<int64_t>({7, 1}));
 }
 
 TEST_CASE("channels come from config; a missing required config is an error") {

@@ -229,6 +229,8 @@ TEST_CASE("heartbeat_t round-trips, including empty and non-ASCII strings") {
   CHECK(r.errors == s.errors);
   CHECK(r.status == s.status);
   CHECK(r.last_error == s.last_error);
+  CHECK(r.counter_names == s.counter_names);
+  CHECK(r.counter_values == s.counter_values);
   CHECK(encode(r) == encode(s));
 
   s.status = "ok";

@@ -238,6 +238,9 @@ inline vimot::heartbeat_t sample_heartbeat() {
   m.errors = d.i64();
   m.status = "degraded";
   m.last_error = "update rejected: chi2 = 41.3 > 12.6 (feature 17)";
+  m.num_counters = 2;
+  m.counter_names = {"bytes_dropped", "reconnects"};
+  m.counter_values = {d.i64(), d.i64()};
   return m;
 }
 
