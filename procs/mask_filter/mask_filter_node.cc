@@ -9,7 +9,8 @@
 namespace vimot {
 
 MaskFilterNodeOptions MaskFilterNodeOptions::from_config(const Config& cfg) {
-  cfg.check_keys("", {"calibration_file", "mode", "filter", "channels", "comment"});
+  // cameras: the calibration inline, when there is no calibration_file.
+  cfg.check_keys("", {"calibration_file", "cameras", "mode", "filter", "channels", "comment"});
   MaskFilterNodeOptions o;
   o.filter = segmentation::MaskFilterOptions::from_config(cfg, "filter");
   const Config calib =

@@ -32,7 +32,8 @@ struct MaskFilterNodeOptions {
 
   /// From a mask filter config (config/mask_filter.yaml): calibration_file
   /// (cameras.cam0/cam1 give the resolution, relative to the file), mode
-  /// (stereo | mono), filter (MaskFilterOptions); `channels` is the
+  /// (stereo | mono), filter (MaskFilterOptions); cameras inline instead of
+  /// a calibration_file; `channels` is the
   /// process's. Throws ConfigError naming the key for a bad or unknown key.
   static MaskFilterNodeOptions from_config(const Config& cfg);
 };
