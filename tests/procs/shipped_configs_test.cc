@@ -18,6 +18,7 @@
 #include "common/object/object_tracker.h"
 #include "common/sim/sim_config.h"
 #include "procs/feature_tracker/feature_tracker_node.h"
+#include "procs/mask_filter/mask_filter_node.h"
 #include "procs/scale_estimator/scale_node.h"
 #include "procs/target_filter/target_filter_node.h"
 #include "procs/vins/vins_node.h"
@@ -37,6 +38,10 @@ void load_with_its_reader(const std::string& name, const std::string& path) {
   } else if (name.rfind("feature_tracker", 0) == 0) {
     const bool mono = name.find("mono") != std::string::npos;
     CHECK(FeatureTrackerNodeOptions::from_config(cfg).cameras.size() == (mono ? 1u : 2u));
+  } else if (name == "mask_filter.yaml") {
+    const MaskFilterNodeOptions o = MaskFilterNodeOptions::from_config(cfg);
+    CHECK(o.resolution.size() == 2);
+    CHECK(o.filter.kalman.max_coast_s == 1.0);
   } else if (name == "object_tracker.yaml") {
     CHECK(object_tracker_options_from_config(cfg).window_size == 20);
   } else if (name == "scale_estimator.yaml") {
