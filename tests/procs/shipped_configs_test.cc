@@ -17,6 +17,7 @@
 #include "common/eval/target_eval.h"
 #include "common/object/object_tracker.h"
 #include "common/sim/sim_config.h"
+#include "drivers/imu_mip/imu_mip_config.h"
 #include "procs/feature_tracker/feature_tracker_node.h"
 #include "procs/mask_filter/mask_filter_node.h"
 #include "procs/scale_estimator/scale_node.h"
@@ -38,6 +39,8 @@ void load_with_its_reader(const std::string& name, const std::string& path) {
   } else if (name.rfind("feature_tracker", 0) == 0) {
     const bool mono = name.find("mono") != std::string::npos;
     CHECK(FeatureTrackerNodeOptions::from_config(cfg).cameras.size() == (mono ? 1u : 2u));
+  } else if (name == "imu_mip.yaml") {
+    CHECK(mip::imu_mip_config_from(cfg).driver.rate_hz > 0.0);
   } else if (name == "mask_filter.yaml") {
     const MaskFilterNodeOptions o = MaskFilterNodeOptions::from_config(cfg);
     CHECK(o.resolution.size() == 2);
