@@ -90,7 +90,7 @@ TEST_CASE("vimot-sheriff --lcm drives a vimot-deputy by procman's protocol") {
   REQUIRE(PollUntil(&deputy, [&] { return deputy_log.HasOutput("deputy 'vehicle' ready"); }));
 
   const std::string command = std::string("'") + VIMOT_SHERIFF_BIN + "' --lcm --lcm-url '" +
-                              kUrl + "' --script exercise '" + config + "' 2>&1";
+                              kUrl + "' --duration 20 --script exercise '" + config + "' 2>&1";
   std::string output;
   std::atomic<bool> sheriff_done{false};
   // The sheriff runs in another thread while this one polls the deputy's runner.
