@@ -4,10 +4,7 @@
 // on PMD_PRINTF, and answers PMD_DISCOVER. All logic is in DeputyNode; this
 // file moves bytes. See docs/sheriff.md.
 
-#include <unistd.h>
-
 #include <chrono>
-#include <climits>
 #include <cstdlib>
 #include <exception>
 #include <functional>
@@ -17,27 +14,13 @@
 #include "common/process/process.h"
 #include "common/time/utime.h"
 #include "procs/deputy/deputy_node.h"
+#include "procs/sheriff/host_info.h"
 #include "procs/sheriff/procman_lcm.h"
 
 namespace {
 
 using vimot::sheriff::FromLcm;
 using vimot::sheriff::ToLcm;
-
-std::string HostName() {
-  std::vector<char> name(HOST_NAME_MAX + 1, '\0');
-  if (::gethostname(name.data(), name.size() - 1) != 0) return "localhost";
-  return name.data();
-}
-
-// Directory of this executable, so commands can say ${VIMOT_BIN}/vimot-sim.
-std::string ExecutableDirectory() {
-  std::vector<char> path(PATH_MAX + 1, '\0');
-  const ssize_t n = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
-  const std::string exe(path.data(), n > 0 ? static_cast<std::size_t>(n) : 0);
-  const std::size_t slash = exe.rfind('/');
-  return slash == std::string::npos ? "." : exe.substr(0, slash);
-}
 
 // procman's types are not in vimot's layout registry (which
 // Process::subscribe checks lengths against), so they are decoded here: a
@@ -88,9 +71,12 @@ int run(int argc, const char* const* argv) {
   if (!process.init(argc, argv)) return 0;
 
   vimot::deputy::DeputyOptions options;
-  options.host = process.args().given("name") ? process.args().get("name") : HostName();
+  options.host =
+      process.args().given("name") ? process.args().get("name") : vimot::sheriff::HostName();
   if (std::getenv("VIMOT_BIN") == nullptr) {
-    options.runner.environment["VIMOT_BIN"] = ExecutableDirectory();
+    if (const auto dir = vimot::sheriff::ExecutableDirectory()) {
+      options.runner.environment["VIMOT_BIN"] = *dir;
+    }
   }
   vimot::deputy::DeputyNode node(options, [&](const vimot::sheriff::DeputyOutput& out) {
     process.publish(vimot::sheriff::kPrintfChannel, ToLcm(out));

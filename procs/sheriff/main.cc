@@ -19,6 +19,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "common/time/utime.h"
+#include "procs/sheriff/host_info.h"
 #include "procs/sheriff/procman_lcm.h"
 #include "procs/sheriff/remote_sheriff.h"
 #include "procs/sheriff/sheriff.h"
@@ -26,6 +27,8 @@
 
 namespace {
 
+using vimot::sheriff::ExecutableDirectory;
+using vimot::sheriff::HostName;
 using vimot::sheriff::Sheriff;
 using vimot::sheriff::SheriffOptions;
 
@@ -105,17 +108,6 @@ void InstallSignalHandlers() {
   signal(SIGPIPE, SIG_IGN);
 }
 
-// Directory of this executable, so configs can say ${VIMOT_BIN}/vimot-sim.
-std::optional<std::string> ExecutableDirectory() {
-  std::vector<char> path(PATH_MAX + 1, '\0');
-  const ssize_t n = readlink("/proc/self/exe", path.data(), path.size() - 1);
-  if (n <= 0) return std::nullopt;
-  const std::string exe(path.data(), static_cast<std::size_t>(n));
-  const std::size_t slash = exe.rfind('/');
-  if (slash == std::string::npos) return std::nullopt;
-  return slash == 0 ? "/" : exe.substr(0, slash);
-}
-
 struct CommandLine {
   SheriffOptions options;
   std::string config_path;
@@ -184,12 +176,6 @@ CommandLine ParseCommandLine(int argc, char** argv) {
     throw std::invalid_argument("no config file given");
   }
   return cl;
-}
-
-std::string HostName() {
-  std::vector<char> name(HOST_NAME_MAX + 1, '\0');
-  if (gethostname(name.data(), name.size() - 1) != 0) return "localhost";
-  return name.data();
 }
 
 // procman's types are decoded here, where a malformed message from the
