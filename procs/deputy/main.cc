@@ -23,8 +23,9 @@ using vimot::sheriff::FromLcm;
 using vimot::sheriff::ToLcm;
 
 // procman's types are not in vimot's layout registry (which
-// Process::subscribe checks lengths against), so they are decoded here: a
-// malformed message is counted and dropped, never a crash.
+// Process::subscribe checks lengths against), so they are decoded here
+// against their own layouts: a malformed message is counted and dropped,
+// never a crash.
 struct Subscription {
   vimot::Process* process;
   std::function<void(const void*, int)> decode_and_call;
@@ -37,13 +38,7 @@ void Subscribe(vimot::Process& process, std::vector<std::unique_ptr<Subscription
   sub->process = &process;
   sub->decode_and_call = [&process, channel, handler](const void* data, int size) {
     Msg msg;
-    bool ok = false;
-    try {
-      ok = msg.decode(data, 0, size) == size;
-    } catch (const std::exception&) {
-      ok = false;  // lcm-gen decoders throw on corrupt lengths
-    }
-    if (!ok) {
+    if (!vimot::sheriff::DecodeProcman(data, size, &msg)) {
       ++process.counters().decode_errors;
       return;
     }

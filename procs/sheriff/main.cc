@@ -178,19 +178,15 @@ CommandLine ParseCommandLine(int argc, char** argv) {
   return cl;
 }
 
-// procman's types are decoded here, where a malformed message from the
-// network is dropped with a note rather than thrown out of lcm.handle().
+// A malformed message from the network is dropped, never thrown out of
+// lcm.handle().
 template <typename Msg>
 std::optional<Msg> Decode(const lcm::ReceiveBuffer* rbuf) {
   Msg msg;
-  try {
-    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) ==
-        static_cast<int>(rbuf->data_size)) {
-      return msg;
-    }
-  } catch (const std::exception&) {
+  if (!vimot::sheriff::DecodeProcman(rbuf->data, static_cast<int>(rbuf->data_size), &msg)) {
+    return std::nullopt;
   }
-  return std::nullopt;
+  return msg;
 }
 
 // --lcm: the run is RemoteSheriff's; this loop moves its messages.

@@ -31,6 +31,67 @@ ProcmanCommand FromLcm(const bot_procman::command2_t& msg) {
 
 }  // namespace
 
+const ProcmanLayouts& procman_layouts() {
+  static const LcmStruct command2{"command2_t", {
+      {"exec_str", LcmKind::kString},
+      {"command_name", LcmKind::kString},
+      {"group", LcmKind::kString},
+      {"auto_respawn", LcmKind::kBoolean},
+      {"stop_signal", LcmKind::kInt8},
+      {"stop_time_allowed", LcmKind::kFloat},
+      {"num_options", LcmKind::kInt32},
+      {"option_names", LcmKind::kString, "num_options"},
+      {"option_values", LcmKind::kString, "num_options"}}};
+  static const LcmStruct sheriff_cmd2{"sheriff_cmd2_t", {
+      {"cmd", command2},
+      {"desired_runid", LcmKind::kInt32},
+      {"force_quit", LcmKind::kInt8},
+      {"sheriff_id", LcmKind::kInt32}}};
+  static const LcmStruct deputy_cmd2{"deputy_cmd2_t", {
+      {"cmd", command2},
+      {"pid", LcmKind::kInt32},
+      {"actual_runid", LcmKind::kInt32},
+      {"exit_code", LcmKind::kInt32},
+      {"cpu_usage", LcmKind::kFloat},
+      {"mem_vsize_bytes", LcmKind::kInt64},
+      {"mem_rss_bytes", LcmKind::kInt64},
+      {"sheriff_id", LcmKind::kInt32}}};
+  static const LcmStruct orders2{"orders2_t", {
+      {"utime", LcmKind::kInt64},
+      {"host", LcmKind::kString},
+      {"sheriff_name", LcmKind::kString},
+      {"ncmds", LcmKind::kInt32},
+      {"cmds", sheriff_cmd2, "ncmds"},
+      {"num_options", LcmKind::kInt32},
+      {"option_names", LcmKind::kString, "num_options"},
+      {"option_values", LcmKind::kString, "num_options"}}};
+  static const LcmStruct info2{"info2_t", {
+      {"utime", LcmKind::kInt64},
+      {"host", LcmKind::kString},
+      {"cpu_load", LcmKind::kFloat},
+      {"phys_mem_total_bytes", LcmKind::kInt64},
+      {"phys_mem_free_bytes", LcmKind::kInt64},
+      {"swap_total_bytes", LcmKind::kInt64},
+      {"swap_free_bytes", LcmKind::kInt64},
+      {"ncmds", LcmKind::kInt32},
+      {"cmds", deputy_cmd2, "ncmds"},
+      {"num_options", LcmKind::kInt32},
+      {"option_names", LcmKind::kString, "num_options"},
+      {"option_values", LcmKind::kString, "num_options"}}};
+  static const LcmStruct printf_msg{"printf_t", {
+      {"utime", LcmKind::kInt64},
+      {"deputy_name", LcmKind::kString},
+      {"sheriff_id", LcmKind::kInt32},
+      {"text", LcmKind::kString}}};
+  static const LcmStruct discovery{"discovery_t", {
+      {"utime", LcmKind::kInt64},
+      {"host", LcmKind::kString},
+      {"nonce", LcmKind::kInt64}}};
+  static const ProcmanLayouts layouts{command2, sheriff_cmd2, deputy_cmd2, orders2,
+                                      info2,    printf_msg,   discovery};
+  return layouts;
+}
+
 bot_procman::orders2_t ToLcm(const DeputyOrders& orders) {
   bot_procman::orders2_t msg;
   msg.utime = orders.utime;

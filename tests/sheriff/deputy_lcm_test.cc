@@ -89,6 +89,22 @@ TEST_CASE("vimot-sheriff --lcm drives a vimot-deputy by procman's protocol") {
   deputy.Start("deputy");
   REQUIRE(PollUntil(&deputy, [&] { return deputy_log.HasOutput("deputy 'vehicle' ready"); }));
 
+  // Hostile orders first: a header claiming 10^8 commands. The deputy must
+  // drop them and go on serving.
+  // fingerprint, utime, host "" and sheriff_name "" (length 1: the NUL), ncmds.
+  std::vector<uint8_t> garbage;
+  const auto put = [&](uint64_t v, int bytes) {
+    for (int i = bytes - 1; i >= 0; --i) garbage.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  };
+  put(static_cast<uint64_t>(bot_procman::orders2_t::getHash()), 8);
+  put(0, 8);
+  put(1, 4);
+  put(0, 1);
+  put(1, 4);
+  put(0, 1);
+  put(100'000'000, 4);
+  listener.publish(kOrdersChannel, garbage.data(), static_cast<unsigned>(garbage.size()));
+
   const std::string command = std::string("'") + VIMOT_SHERIFF_BIN + "' --lcm --lcm-url '" +
                               kUrl + "' --duration 20 --script exercise '" + config + "' 2>&1";
   std::string output;
@@ -143,6 +159,7 @@ TEST_CASE("vimot-sheriff --lcm drives a vimot-deputy by procman's protocol") {
   int64_t last_runid = 0;
   bool saw_talker_output = false;
   for (const auto& [channel, bytes] : capture.messages) {
+    if (bytes == garbage) continue;
     ++counts[channel];
     if (channel == kOrdersChannel) {
       bot_procman::orders2_t msg;
