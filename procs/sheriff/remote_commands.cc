@@ -105,14 +105,17 @@ bool RemoteCommands::OnInfo(const DeputyInfo& info) {
       const CommandStatus before = r.state.status;
       const pid_t pid_before = r.state.pid;
       const bool was_running = r.report && r.report->pid > 0;
+      const bool new_run = report.actual_runid != (r.report ? r.report->actual_runid : 0);
       if (report.pid > 0 && (!r.report || r.report->pid != report.pid)) {
         ++r.state.start_count;
-        if (r.report && r.report->actual_runid == report.actual_runid) {
-          ++r.state.respawn_count;
-        }
+        if (r.report && !new_run) ++r.state.respawn_count;
       }
-      if (was_running && report.pid != r.report->pid) ++r.state.exit_count;
-      if (report.pid == 0 && was_running) {
+      // A run ended: one seen alive, or one that started and ended between
+      // two reports (a command that fails at once).
+      const bool ended_unseen = report.pid == 0 && !was_running && new_run;
+      if (ended_unseen) ++r.state.start_count;
+      if ((was_running && report.pid != r.report->pid) || ended_unseen) {
+        ++r.state.exit_count;
         r.state.last_exit = DecodeWaitStatus(report.exit_code);
       }
       r.report = report;

@@ -146,6 +146,7 @@ TEST_CASE("sheriff starts, stops and restarts a command on a deputy") {
   CHECK(!Alive(second_pid));
   // Stopped by its stop signal: the reported status is waitpid()'s.
   CHECK(link.Report("talker")->exit_code == SIGTERM);
+  REQUIRE(link.sheriff.state("talker").last_exit);
   CHECK(link.sheriff.state("talker").last_exit->signal == SIGTERM);
 }
 
@@ -187,7 +188,11 @@ TEST_CASE("a command that exits on its own reports its exit code") {
   link.sheriff.Start("quitter");
   REQUIRE(link.Until([&] { return link.Status("quitter") == CommandStatus::kExited; }));
   CHECK(link.Report("quitter")->exit_code == (3 << 8));
+  // Even when it started and ended between two reports.
+  REQUIRE(link.sheriff.state("quitter").last_exit);
   CHECK(link.sheriff.state("quitter").last_exit->exit_code == 3);
+  CHECK(link.sheriff.state("quitter").start_count == 1);
+  CHECK(link.sheriff.state("quitter").exit_count == 1);
   // Same run id: the deputy does not start it again by itself.
   for (int i = 0; i < 5; ++i) link.Exchange();
   CHECK(link.Status("quitter") == CommandStatus::kExited);
