@@ -59,6 +59,19 @@ struct Capture {
   }
 };
 
+/// Runs a shell command; its stdout (and stderr, if redirected) and exit
+/// status, -1 when it did not exit normally.
+std::pair<int, std::string> RunCommand(const std::string& command) {
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string output;
+  char buffer[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) output.append(buffer, n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
 template <typename Msg>
 bool DecodesAs(const std::vector<uint8_t>& bytes, Msg* msg) {
   return msg->decode(bytes.data(), 0, static_cast<int>(bytes.size())) ==
@@ -111,16 +124,8 @@ TEST_CASE("vimot-sheriff --lcm drives a vimot-deputy by procman's protocol") {
   std::atomic<bool> sheriff_done{false};
   // The sheriff runs in another thread while this one polls the deputy's runner.
   std::thread sheriff_thread([&] {
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr) {
-      sheriff_done = true;
-      return;
-    }
-    char buffer[4096];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) output.append(buffer, n);
-    const int status = ::pclose(pipe);
-    output += "\nEXIT " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    const auto [status, text] = RunCommand(command);
+    output = text + "\nEXIT " + std::to_string(status);
     sheriff_done = true;
   });
   const Clock::time_point end = Clock::now() + std::chrono::seconds(30);
@@ -190,3 +195,15 @@ TEST_CASE("vimot-sheriff --lcm drives a vimot-deputy by procman's protocol") {
   CHECK(counts[kInfoChannel] > 0);
   CHECK(counts[kDiscoverChannel] == 1);
 }
+
+TEST_CASE("vimot-sheriff --lcm rejects what it cannot do before sending anything") {
+  TempDir dir;
+  const std::string config = dir.path() + "/exercise.pmd";
+  std::ofstream(config) << kConfig;
+  const std::string command = std::string("'") + VIMOT_SHERIFF_BIN + "' --lcm --lcm-url '" +
+                              kUrl + "' --exit-when talker '" + config + "' 2>&1";
+  const auto [status, output] = RunCommand(command);
+  CHECK(status == 2);
+  CHECK(output.find("--exit-when is not supported with --lcm") != std::string::npos);
+}
+
