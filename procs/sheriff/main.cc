@@ -175,6 +175,9 @@ CommandLine ParseCommandLine(int argc, char** argv) {
   if (!cl.help && cl.config_path.empty()) {
     throw std::invalid_argument("no config file given");
   }
+  if (!cl.lcm && (!cl.lcm_url.empty() || !cl.local_host.empty())) {
+    throw std::invalid_argument("--lcm-url and --local-host only apply with --lcm");
+  }
   return cl;
 }
 

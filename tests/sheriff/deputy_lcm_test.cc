@@ -205,5 +205,10 @@ TEST_CASE("vimot-sheriff --lcm rejects what it cannot do before sending anything
   const auto [status, output] = RunCommand(command);
   CHECK(status == 2);
   CHECK(output.find("--exit-when is not supported with --lcm") != std::string::npos);
+  // An LCM option without --lcm is a mistake, not something to ignore.
+  const auto [status2, output2] = RunCommand(std::string("'") + VIMOT_SHERIFF_BIN +
+                                             "' --lcm-url '" + kUrl + "' '" + config + "' 2>&1");
+  CHECK(status2 == 2);
+  CHECK(output2.find("only apply with --lcm") != std::string::npos);
 }
 
