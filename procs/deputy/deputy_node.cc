@@ -10,6 +10,8 @@ using sheriff::CommandStatus;
 
 namespace {
 
+constexpr int kCannotRunExitCode = 127;
+
 bool IsAlive(CommandStatus s) {
   return s == CommandStatus::kRunning || s == CommandStatus::kStopping;
 }
@@ -161,6 +163,11 @@ sheriff::DeputyInfo DeputyNode::Info(int64_t now_utime) {
       const sheriff::CommandState& state = c.runner->state(c.running_spec.name);
       if (IsAlive(state.status) && state.pid > 0) report.pid = state.pid;
       if (state.last_exit) report.exit_code = sheriff::EncodeWaitStatus(*state.last_exit);
+      // Could not be started (undefined variable, fork failure; the reason
+      // went out on PMD_PRINTF): the shell's "cannot run" status.
+      if (state.status == CommandStatus::kFailed) {
+        report.exit_code = sheriff::EncodeWaitStatus({kCannotRunExitCode, 0});
+      }
     }
     if (report.pid > 0) {
       const std::optional<ProcessStats> stats = ReadProcessStats(report.pid);

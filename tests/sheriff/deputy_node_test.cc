@@ -249,3 +249,27 @@ TEST_CASE("an auto_respawn command exits and the deputy starts it again") {
   // Respawns keep the run id: the sheriff asked for one run only.
   CHECK(deputy.Info(Now()).cmds.at(0).actual_runid == 1);
 }
+
+TEST_CASE("a command that cannot be started reports status 127 and why") {
+  SheriffConfig config = ParseSheriffConfig(R"(
+    cmd "broken" { exec = "${VIMOT_DEPUTY_TEST_UNDEFINED_VARIABLE}/x"; host = "vehicle"; }
+  )", "broken.pmd");
+  RemoteCommands sheriff(config, {"test-sheriff", "vehicle"});
+  std::vector<DeputyOutput> outputs;
+  DeputyNode deputy(Link::Options(), [&](const DeputyOutput& o) { outputs.push_back(o); });
+  sheriff.Start("broken");
+  for (int i = 0; i < 3; ++i) {
+    for (const DeputyOrders& o : sheriff.Orders(Now())) deputy.OnOrders(o, Now());
+    deputy.Poll(milliseconds(20), Now());
+    sheriff.OnInfo(deputy.Info(Now()));
+  }
+  CHECK(sheriff.state("broken").status == CommandStatus::kExited);
+  REQUIRE(sheriff.state("broken").last_exit);
+  CHECK(sheriff.state("broken").last_exit->exit_code == 127);
+  bool named = false;
+  for (const DeputyOutput& o : outputs) {
+    named |= o.text.find("VIMOT_DEPUTY_TEST_UNDEFINED_VARIABLE") != std::string::npos;
+  }
+  CHECK(named);
+}
+
