@@ -16,11 +16,19 @@
 #include <string>
 #include <vector>
 
+#include <lcm/lcm-cpp.hpp>
+
+#include "common/time/utime.h"
+#include "procs/sheriff/host_info.h"
+#include "procs/sheriff/procman_lcm.h"
+#include "procs/sheriff/remote_sheriff.h"
 #include "procs/sheriff/sheriff.h"
 #include "procs/sheriff/sheriff_config_parser.h"
 
 namespace {
 
+using vimot::sheriff::ExecutableDirectory;
+using vimot::sheriff::HostName;
 using vimot::sheriff::Sheriff;
 using vimot::sheriff::SheriffOptions;
 
@@ -42,6 +50,13 @@ options:
                     code 0), stop everything else and exit with CMD's status
   --duration SEC    stop everything after SEC seconds (decimals allowed)
   --list            print the config's groups, commands and scripts and exit
+  --lcm             run nothing here: send procman orders (PMD_ORDERS2) to the
+                    deputy of each command's host (vimot-deputy or libbot2's
+                    bot-procman-deputy) and follow their PMD_INFO2 and
+                    PMD_PRINTF; --exit-when is not available
+  --lcm-url URL     LCM URL for --lcm (default: $LCM_DEFAULT_URL, else LCM's)
+  --local-host NAME deputy of commands with host "localhost" (default: this
+                    machine's hostname)
   -h, --help        print this help
 
 config format (libbot2 procman, '#' starts a comment):
@@ -93,21 +108,13 @@ void InstallSignalHandlers() {
   signal(SIGPIPE, SIG_IGN);
 }
 
-// Directory of this executable, so configs can say ${VIMOT_BIN}/vimot-sim.
-std::optional<std::string> ExecutableDirectory() {
-  std::vector<char> path(PATH_MAX + 1, '\0');
-  const ssize_t n = readlink("/proc/self/exe", path.data(), path.size() - 1);
-  if (n <= 0) return std::nullopt;
-  const std::string exe(path.data(), static_cast<std::size_t>(n));
-  const std::size_t slash = exe.rfind('/');
-  if (slash == std::string::npos) return std::nullopt;
-  return slash == 0 ? "/" : exe.substr(0, slash);
-}
-
 struct CommandLine {
   SheriffOptions options;
   std::string config_path;
   bool list{false};
+  bool lcm{false};
+  std::string lcm_url;
+  std::string local_host;
   bool help{false};
 };
 
@@ -132,6 +139,12 @@ CommandLine ParseCommandLine(int argc, char** argv) {
       cl.help = true;
     } else if (arg == "--list") {
       cl.list = true;
+    } else if (arg == "--lcm") {
+      cl.lcm = true;
+    } else if (arg == "--lcm-url") {
+      cl.lcm_url = value();
+    } else if (arg == "--local-host") {
+      cl.local_host = value();
     } else if (arg == "--script") {
       cl.options.script = value();
     } else if (arg == "--group") {
@@ -162,7 +175,81 @@ CommandLine ParseCommandLine(int argc, char** argv) {
   if (!cl.help && cl.config_path.empty()) {
     throw std::invalid_argument("no config file given");
   }
+  if (!cl.lcm && (!cl.lcm_url.empty() || !cl.local_host.empty())) {
+    throw std::invalid_argument("--lcm-url and --local-host only apply with --lcm");
+  }
   return cl;
+}
+
+// A malformed message from the network is dropped, never thrown out of
+// lcm.handle().
+template <typename Msg>
+std::optional<Msg> Decode(const lcm::ReceiveBuffer* rbuf) {
+  Msg msg;
+  if (!vimot::sheriff::DecodeProcman(rbuf->data, static_cast<int>(rbuf->data_size), &msg)) {
+    return std::nullopt;
+  }
+  return msg;
+}
+
+// --lcm: the run is RemoteSheriff's; this loop moves its messages.
+int RunOverLcm(vimot::sheriff::SheriffConfig config, CommandLine cl) {
+  using vimot::sheriff::FromLcm;
+  using vimot::sheriff::ToLcm;
+  lcm::LCM lcm(cl.lcm_url);
+  if (!lcm.good()) {
+    std::cerr << "vimot-sheriff: cannot open LCM '" << cl.lcm_url << "'\n";
+    return kUsageError;
+  }
+  vimot::sheriff::RemoteOptions remote;
+  remote.local_host = cl.local_host.empty() ? HostName() : cl.local_host;
+  remote.sheriff_name = "vimot-sheriff@" + HostName() + ":" + std::to_string(getpid());
+  std::optional<vimot::sheriff::RemoteSheriff> sheriff;
+  try {
+    sheriff.emplace(std::move(config), std::move(cl.options), remote);
+  } catch (const std::exception& e) {
+    std::cerr << "vimot-sheriff: " << e.what() << "\n";
+    return kUsageError;
+  }
+  lcm.subscribeFunction(
+      vimot::sheriff::kInfoChannel,
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, vimot::sheriff::RemoteSheriff* s) {
+        if (auto msg = Decode<bot_procman::info2_t>(rbuf)) s->OnInfo(FromLcm(*msg));
+      },
+      &*sheriff);
+  lcm.subscribeFunction(
+      vimot::sheriff::kPrintfChannel,
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, vimot::sheriff::RemoteSheriff* s) {
+        const auto msg = Decode<bot_procman::printf_t>(rbuf);
+        if (!msg) return;
+        const vimot::sheriff::DeputyOutput out = FromLcm(*msg);
+        const auto prefix = s->OutputPrefix(out);
+        if (!prefix) return;  // another sheriff's command
+        std::string text = out.text;
+        if (!text.empty() && text.back() == '\n') text.pop_back();
+        std::cout << *prefix << text << std::endl;
+      },
+      &*sheriff);
+
+  bot_procman::discovery_t discovery;
+  discovery.utime = vimot::wall_clock_utime();
+  discovery.host = HostName();
+  discovery.nonce = getpid();
+  lcm.publish(vimot::sheriff::kDiscoverChannel, &discovery);
+
+  InstallSignalHandlers();
+  sheriff->Begin();
+  while (true) {
+    if (lcm.handleTimeout(50) < 0 && g_pending_signal.load() == 0) {
+      std::cerr << "vimot-sheriff: LCM receive failed\n";
+      return 1;
+    }
+    if (const auto code = sheriff->Step(g_pending_signal.exchange(0))) return *code;
+    for (const auto& orders : sheriff->DueOrders(vimot::wall_clock_utime())) {
+      const bot_procman::orders2_t msg = ToLcm(orders);
+      lcm.publish(vimot::sheriff::kOrdersChannel, &msg);
+    }
+  }
 }
 
 }  // namespace
@@ -194,6 +281,7 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  if (cl.lcm) return RunOverLcm(std::move(config), std::move(cl));
   if (std::getenv("VIMOT_BIN") == nullptr) {
     if (const auto dir = ExecutableDirectory()) {
       cl.options.runner.environment["VIMOT_BIN"] = *dir;

@@ -45,16 +45,6 @@ std::string Seconds(milliseconds d) {
   return text;
 }
 
-ExitInfo DecodeWaitStatus(int wait_status) {
-  ExitInfo info;
-  if (WIFSIGNALED(wait_status)) {
-    info.signal = WTERMSIG(wait_status);
-  } else if (WIFEXITED(wait_status)) {
-    info.exit_code = WEXITSTATUS(wait_status);
-  }
-  return info;
-}
-
 // True while any process (zombies included) is in process group `pgid`.
 bool GroupExists(pid_t pgid) {
   return pgid > 0 && (::kill(-pgid, 0) == 0 || errno != ESRCH);
@@ -145,6 +135,20 @@ const char* ToString(CommandStatus status) {
       return "remote";
   }
   return "unknown";
+}
+
+ExitInfo DecodeWaitStatus(int wait_status) {
+  ExitInfo info;
+  if (WIFSIGNALED(wait_status)) {
+    info.signal = WTERMSIG(wait_status);
+  } else if (WIFEXITED(wait_status)) {
+    info.exit_code = WEXITSTATUS(wait_status);
+  }
+  return info;
+}
+
+int EncodeWaitStatus(const ExitInfo& exit) {
+  return exit.signal != 0 ? exit.signal : (exit.exit_code & 0xff) << 8;
 }
 
 std::string ExitInfo::ToString() const {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "procs/sheriff/command_control.h"
 #include "procs/sheriff/group_watchdog.h"
 #include "procs/sheriff/line_splitter.h"
 #include "procs/sheriff/sheriff_config.h"
@@ -105,6 +106,11 @@ struct RunnerOptions {
   std::function<void(const std::string& message)> on_event;
 };
 
+/// How a process ended, from a waitpid() status.
+ExitInfo DecodeWaitStatus(int wait_status);
+/// The waitpid() status of an ExitInfo (procman reports it in deputy info).
+int EncodeWaitStatus(const ExitInfo& exit);
+
 /// The line given to `/bin/sh -c` for `command`: "exec <command>" when it is
 /// one simple command (no ; & | ( ) or newline outside quotes, other than
 /// the & of a redirection such as 2>&1; not starting
@@ -133,7 +139,7 @@ std::string ShellCommandLine(const std::string& command);
 /// before the command counts as exited or is respawned. The commands die
 /// with the runner's process, even by SIGKILL: each child gets
 /// PR_SET_PDEATHSIG (its stop_signal) and a GroupWatchdog stops every group.
-class ProcessRunner {
+class ProcessRunner : public CommandControl {
  public:
   /// Throws std::invalid_argument on duplicate or empty command names and on
   /// non-positive back-off options.
@@ -141,7 +147,7 @@ class ProcessRunner {
                          RunnerOptions options = {});
   /// SIGKILLs and reaps whatever is still running: a runner that goes away
   /// must not leave orphans behind.
-  ~ProcessRunner();
+  ~ProcessRunner() override;
 
   ProcessRunner(const ProcessRunner&) = delete;
   ProcessRunner& operator=(const ProcessRunner&) = delete;
@@ -151,13 +157,13 @@ class ProcessRunner {
   /// kFailed and an event names the cause. A stopping command is started
   /// again as soon as it has stopped. Remote commands are reported and
   /// skipped. Throws std::invalid_argument for an unknown name.
-  void Start(const std::string& name);
+  void Start(const std::string& name) override;
   /// Sends stop_signal to the command's process group, then SIGKILL after
   /// stop_time_allowed. Cancels a pending respawn or restart. No-op for a
   /// command that is not running.
-  void Stop(const std::string& name);
+  void Stop(const std::string& name) override;
   /// Stop, then Start once the process group has ended.
-  void Restart(const std::string& name);
+  void Restart(const std::string& name) override;
   /// Stops every command one after the other in reverse start order (the
   /// last started is stopped first, as the ones started earlier are usually
   /// what later ones depend on), waiting for each to end before the next.
@@ -182,10 +188,10 @@ class ProcessRunner {
 
   bool HasCommand(const std::string& name) const;
   /// Throws std::invalid_argument for an unknown name.
-  const CommandState& state(const std::string& name) const;
+  const CommandState& state(const std::string& name) const override;
   const CommandSpec& spec(const std::string& name) const;
   /// False for commands of another host.
-  bool IsLocal(const std::string& name) const;
+  bool IsLocal(const std::string& name) const override;
   /// In the order given to the constructor.
   std::vector<std::string> command_names() const;
 

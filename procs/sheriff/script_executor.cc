@@ -15,7 +15,7 @@ bool IsStoppedStatus(CommandStatus status) {
 
 }  // namespace
 
-ScriptExecutor::ScriptExecutor(const SheriffConfig& config, ProcessRunner* runner,
+ScriptExecutor::ScriptExecutor(const SheriffConfig& config, CommandControl* runner,
                                const std::string& script_name,
                                std::function<void(const std::string&)> on_event)
     : config_(config),

@@ -7,12 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "procs/sheriff/command_control.h"
 #include "procs/sheriff/process_runner.h"
 #include "procs/sheriff/sheriff_config.h"
 
 namespace vimot::sheriff {
 
-/// Runs one procman script against a ProcessRunner, one action after the
+/// Runs one procman script against a ProcessRunner (or RemoteCommands), one action after the
 /// other, without blocking: Step() performs every action it can and returns
 /// when the script has to wait (`wait ms`, `wait ... status`, or an action's
 /// `wait "running"|"stopped"`), so the caller's loop keeps forwarding output
@@ -31,7 +32,7 @@ class ScriptExecutor {
   /// `config` and `runner` must outlive the executor; the runner must hold
   /// the config's commands. Throws std::invalid_argument for an unknown
   /// script. `on_event` receives progress lines (default: stderr).
-  ScriptExecutor(const SheriffConfig& config, ProcessRunner* runner,
+  ScriptExecutor(const SheriffConfig& config, CommandControl* runner,
                  const std::string& script_name,
                  std::function<void(const std::string&)> on_event = {});
 
@@ -74,7 +75,7 @@ class ScriptExecutor {
   void Fail(const std::string& message);
 
   const SheriffConfig& config_;
-  ProcessRunner* runner_{nullptr};
+  CommandControl* runner_{nullptr};
   std::string script_name_;
   std::function<void(const std::string&)> on_event_;
   std::vector<Frame> stack_;

@@ -27,36 +27,43 @@ SheriffOptions WithDefaultEventSink(SheriffOptions options) {
 
 }  // namespace
 
+std::vector<std::string> SelectCommands(const SheriffConfig& config,
+                                        const SheriffOptions& options) {
+  std::vector<std::string> selected;
+  if (!options.script.empty() && !options.group.empty()) {
+    throw std::invalid_argument(
+        "give either a script (" + options.script + ") or a group (" +
+        options.group + ") to start, not both");
+  }
+  if (!options.script.empty()) {
+    if (config.FindScript(options.script) == nullptr) {
+      std::string known;
+      for (const ScriptSpec& s : config.scripts()) known += " '" + s.name + "'";
+      throw std::invalid_argument("unknown script '" + options.script +
+                                  "'; the config has:" +
+                                  (known.empty() ? " no scripts" : known));
+    }
+    selected = ScriptExecutor::CommandsStartedBy(config, options.script);
+  } else if (!options.group.empty()) {
+    if (config.FindGroup(options.group) == nullptr) {
+      std::string known;
+      for (const GroupSpec& g : config.groups()) known += " '" + g.name + "'";
+      throw std::invalid_argument("unknown group '" + options.group +
+                                  "'; the config has:" +
+                                  (known.empty() ? " no groups" : known));
+    }
+    selected = config.CommandsInGroup(options.group);
+  } else {
+    for (const CommandSpec& c : config.commands()) selected.push_back(c.name);
+  }
+  return selected;
+}
+
 Sheriff::Sheriff(SheriffConfig config, SheriffOptions options)
     : config_(std::move(config)),
       options_(WithDefaultEventSink(std::move(options))),
       runner_(config_.commands(), options_.runner) {
-  if (!options_.script.empty() && !options_.group.empty()) {
-    throw std::invalid_argument(
-        "give either a script (" + options_.script + ") or a group (" +
-        options_.group + ") to start, not both");
-  }
-  if (!options_.script.empty()) {
-    if (config_.FindScript(options_.script) == nullptr) {
-      std::string known;
-      for (const ScriptSpec& s : config_.scripts()) known += " '" + s.name + "'";
-      throw std::invalid_argument("unknown script '" + options_.script +
-                                  "'; the config has:" +
-                                  (known.empty() ? " no scripts" : known));
-    }
-    selected_ = ScriptExecutor::CommandsStartedBy(config_, options_.script);
-  } else if (!options_.group.empty()) {
-    if (config_.FindGroup(options_.group) == nullptr) {
-      std::string known;
-      for (const GroupSpec& g : config_.groups()) known += " '" + g.name + "'";
-      throw std::invalid_argument("unknown group '" + options_.group +
-                                  "'; the config has:" +
-                                  (known.empty() ? " no groups" : known));
-    }
-    selected_ = config_.CommandsInGroup(options_.group);
-  } else {
-    for (const CommandSpec& c : config_.commands()) selected_.push_back(c.name);
-  }
+  selected_ = SelectCommands(config_, options_);
   if (!options_.exit_when.empty()) {
     if (config_.FindCommand(options_.exit_when) == nullptr) {
       throw std::invalid_argument("--exit-when: unknown command '" +

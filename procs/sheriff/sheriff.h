@@ -26,6 +26,12 @@ struct SheriffOptions {
   RunnerOptions runner;
 };
 
+/// The commands `options` starts (all, the group's, or the script's), in
+/// config order. Throws std::invalid_argument for an unknown script or
+/// group, or both given.
+std::vector<std::string> SelectCommands(const SheriffConfig& config,
+                                        const SheriffOptions& options);
+
 /// A headless procman sheriff for this machine: owns the config, a
 /// ProcessRunner for its commands and, with a script, a ScriptExecutor, and
 /// runs the event loop until the run is over.

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -44,4 +45,15 @@ TEST_CASE("shipped sheriff configs parse") {
                {"vins_mono.yaml", "scale_estimator.yaml"});
   // config/feature_tracker.yaml comes with the feature tracker (issue 11, item 2).
   check_config("euroc.pmd", {"logger", "vins", "feature_tracker", "euroc_player"}, {"vins_euroc.yaml"});
+}
+
+TEST_CASE("the two-host layout puts each command on its machine") {
+  check_config("two_hosts.pmd", {"logger", "vins", "target_filter", "sim"}, {"target_filter.yaml"});
+  const SheriffConfig config = LoadSheriffConfig(source_path("sheriff_configs/two_hosts.pmd"));
+  std::map<std::string, std::string> host;
+  for (const CommandSpec& c : config.commands()) host[c.name] = c.host;
+  CHECK(host["logger"] == "ground");
+  CHECK(host["vins"] == "vehicle");
+  CHECK(host["target_filter"] == "vehicle");
+  CHECK(host["sim"] == "vehicle");
 }
