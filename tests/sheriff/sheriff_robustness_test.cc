@@ -51,7 +51,9 @@ TEST_CASE("the pid and a clean exit on the stop signal are the program's own, no
   runner.Start("clean");
   runner.Start("sleeper");
   REQUIRE(PollUntil(&runner, [&] { return rec.HasOutput("[clean] ready"); }));
-  CHECK(Program(runner.state("sleeper").pid) == "sleep");
+  // The pid is the wrapper's until its exec, microseconds after the fork:
+  // wait for the exec, then it must be the program's own.
+  CHECK(PollUntil(&runner, [&] { return Program(runner.state("sleeper").pid) == "sleep"; }));
   CHECK(Program(runner.state("clean").pid) == "sh");
 
   runner.Stop("clean");
