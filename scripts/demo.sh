@@ -2,6 +2,8 @@
 # The README's main job: the simulated scenario through the LCM stack.
 #   scripts/demo.sh        stereo target tracking (Schmidt-EKF paper)
 #   scripts/demo.sh mono   monocular metric scale (scale paper)
+#   scripts/demo.sh pixels stereo target tracking from rendered images: the
+#                          simulator renders, the feature tracker makes FEATURES
 # Installs what is missing, builds, starts the processes of a sheriff config
 # with vimot-sheriff and prints a summary: processes, messages per channel,
 # the accuracy of the LCM run against ground truth, the same scenario run
@@ -11,6 +13,11 @@
 #  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
 #    scale estimator, lcm-logger): VIO accuracy, scale error, the metric
 #    object pose error in the world and that of the object motion filter.
+#  - pixels: sheriff_configs/sim_pixels.pmd (simulator rendering images,
+#    feature tracker with the true target box, vins, target filter,
+#    lcm-logger): VIO accuracy of the LCM run against the same seed's
+#    offline run from pixels (vimot-vio-eval --pixels) and next to the
+#    feature-level run of that seed.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
@@ -20,6 +27,9 @@
 #                     cores, 10 is too fast for the target filter: UDP drops
 #                     messages and the LCM figures no longer equal the offline ones)
 #   VIMOT_SEED        noise seed (default 1)
+#   VIMOT_DURATION    pixels: seconds to simulate (default 30; rendering and
+#                     tracking cost ≈ 25 ms per stereo frame, so the default
+#                     speed there is 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml; mono:
 #                     vins_mono.yaml)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
@@ -36,8 +46,9 @@ pipeline=target
 case "${1:-}" in
   -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
   mono) pipeline=mono ;;
+  pixels) pipeline=pixels ;;
   "") ;;
-  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono' or --help)" >&2; exit 1 ;;
+  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels' or --help)" >&2; exit 1 ;;
 esac
 
 "$here/scripts/build.sh"
@@ -48,6 +59,12 @@ if [ $pipeline = mono ]; then
   pmd="$here/sheriff_configs/sim_mono.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_mono.yaml}"
   export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
+  export VIMOT_SPEED="${VIMOT_SPEED:-1}"
+elif [ $pipeline = pixels ]; then
+  pmd="$here/sheriff_configs/sim_pixels.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
+  export VIMOT_TRACKER_CONFIG="${VIMOT_TRACKER_CONFIG:-feature_tracker_sim.yaml}"
+  export VIMOT_DURATION="${VIMOT_DURATION:-30}"
   export VIMOT_SPEED="${VIMOT_SPEED:-1}"
 else
   pmd="$here/sheriff_configs/sim_demo.pmd"
@@ -80,12 +97,26 @@ echo "== messages per channel in the log:"
 "$VIMOT_BIN/vimot-log-summary" "$VIMOT_LOG" | sed 's/^/   /'
 echo "== VIO accuracy of the LCM run (VINS_STATE vs GROUND_TRUTH):"
 perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" | head -n 1)
+# The same seed offline, in-process: the figures the LCM run must equal.
+offline_args=()
+if [ $pipeline = pixels ]; then
+  offline_args=(--duration "$VIMOT_DURATION" --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG")
+fi
 "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
   --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
-  --perturb-seed "${perturb_seed:-0}" --out "$out/offline" --quiet > "$out/offline.txt" 2>&1 || true
+  --perturb-seed "${perturb_seed:-0}" "${offline_args[@]}" --out "$out/offline" --quiet > "$out/offline.txt" 2>&1 || true
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --json "$out/lcm_summary.json" \
   --compare "$out/offline/summary.json" | sed 's/^/   /'
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
+if [ $pipeline = pixels ]; then
+  echo "== the same seed at feature level (the simulator's own tracks, no pixels), offline:"
+  "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+    --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
+    --duration "$VIMOT_DURATION" --perturb-seed "${perturb_seed:-0}" --quiet > "$out/offline_features.txt" 2>&1 || true
+  grep -E '^(seed|mean|pred)' "$out/offline_features.txt" | sed 's/^/   /'
+  echo "== log (images left out): $VIMOT_LOG"
+  exit 0
+fi
 if [ $pipeline = mono ]; then
   echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run:"
   "$VIMOT_BIN/vimot-scale-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \

@@ -43,8 +43,10 @@ TEST_CASE("shipped sheriff configs parse") {
   // config/object_tracker.yaml comes with the object tracker (issue 5, tracker branch).
   check_config("sim_mono.pmd", {"logger", "vins", "object_tracker", "scale_estimator", "sim"},
                {"vins_mono.yaml", "scale_estimator.yaml"});
-  // config/feature_tracker.yaml comes with the feature tracker (issue 11, item 2).
-  check_config("euroc.pmd", {"logger", "vins", "feature_tracker", "euroc_player"}, {"vins_euroc.yaml"});
+  check_config("euroc.pmd", {"logger", "vins", "feature_tracker", "euroc_player"},
+               {"vins_euroc.yaml", "feature_tracker.yaml"});
+  check_config("sim_pixels.pmd", {"logger", "vins", "target_filter", "feature_tracker", "sim"},
+               {"target_filter.yaml"});
 }
 
 TEST_CASE("the two-host layout puts each command on its machine") {
