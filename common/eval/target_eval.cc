@@ -68,8 +68,8 @@ target::TargetFilterOptions target_filter_options(const Config& config) {
   TargetFilterOptions o;
   if (!config.has("target")) return o;
   const Config c = config.sub("target");
-  check_keys(c, {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times", "init_sigmas",
-                 "points", "prediction_horizon_s" /* the vimot-target-filter process's, ignored here */});
+  check_keys(c, {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times", "init",
+                 "init_sigmas", "points", "prediction_horizon_s" /* the vimot-target-filter process's, ignored here */});
   if (c.has("mode")) {
     try {
       o.mode = parse_target_mode(c.get<std::string>("mode"));
@@ -88,6 +88,22 @@ target::TargetFilterOptions target_filter_options(const Config& config) {
   o.planar = c.get_or<bool>("planar", o.planar);
   o.chi2_multiplier = positive(c, "chi2_multiplier", o.chi2_multiplier);
   o.min_clone_times = at_least(c, "min_clone_times", o.min_clone_times, 2);
+  if (c.has("init")) {
+    const Config i = c.sub("init");
+    check_keys(i, {"mode", "frames", "min_points", "max_point_distance", "sigma_w"});
+    if (i.has("mode")) {
+      try {
+        o.init_mode = target::parse_init_mode(i.get<std::string>("mode"));
+      } catch (const std::invalid_argument& e) {
+        i.fail("mode", e.what());
+      }
+    }
+    target::TargetFeatureInit& f = o.feature_init;
+    f.frames = at_least(i, "frames", f.frames, 2);
+    f.min_points = at_least(i, "min_points", f.min_points, 1);
+    f.max_point_distance = positive(i, "max_point_distance", f.max_point_distance);
+    f.sigma_w = positive(i, "sigma_w", f.sigma_w);
+  }
   if (c.has("init_sigmas")) {
     const Config s = c.sub("init_sigmas");
     check_keys(s, {"theta", "p", "v", "w"});
@@ -177,10 +193,15 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
           x_i = target::global_to_local(ip, x);
           P_i = target::global_to_local_covariance(ip, x, P18);
         }
-        const TargetInImu truth_in_imu = true_target_in_imu(truth);
+        // A frame of the filter's own (features start): fixed at its first estimate.
+        if (e_ti.count() == 0 && filter->options().init_mode == target::TargetInitMode::kFeatures) {
+          r.target_frame = target_frame_transform(truth, x_i.q_RtoT, x_i.p_TinR);
+        }
+        const GroundTruth t = in_target_frame(truth, r.target_frame);
+        const TargetInImu truth_in_imu = true_target_in_imu(t);
         const ErrorSample ti = compute_error(frame.utime, truth_in_imu.q_ItoT, truth_in_imu.p_TinI, x_i.q_RtoT, x_i.p_TinR,
                                              P_i.block<3, 3>(0, 0), P_i.block<3, 3>(3, 3));
-        const ErrorSample tg = compute_error(frame.utime, truth.q_GtoT, truth.p_TinG, x_g.q_RtoT, x_g.p_TinR,
+        const ErrorSample tg = compute_error(frame.utime, t.q_GtoT, t.p_TinG, x_g.q_RtoT, x_g.p_TinR,
                                              P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3));
         e_ti.add(ti);
         e_tg.add(tg);
@@ -429,6 +450,17 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
       j.begin_object();
       j.field("sim_seed", r.sim_seed).field("perturb_seed", r.perturb_seed).field("diverged", r.diverged);
       if (r.diverged) j.field("divergence_reason", r.divergence_reason);
+      if (!c.vio_only) {
+        j.key("target_frame").begin_object();
+        j.field("angle_deg", r.target_frame.angle_deg());
+        j.key("q_TtoTest").begin_array();
+        for (int k = 0; k < 4; ++k) j.value(r.target_frame.q_TtoTest(k));
+        j.end_array();
+        j.key("p_TestInT").begin_array();
+        for (int k = 0; k < 3; ++k) j.value(r.target_frame.p_TestInT(k));
+        j.end_array();
+        j.end_object();
+      }
       j.key("target_in_imu");
       write_summary_json(j, r.target_in_imu);
       j.key("target_in_world");

@@ -43,6 +43,12 @@ void target_options_from_config(const Config& cfg, TargetFilterNodeOptions* opti
   t.max_target_points = cfg.get_or<int>("target.points.max", t.max_target_points);
   t.point_init_clone_times = cfg.get_or<int>("target.points.init_clone_times", t.point_init_clone_times);
   t.point_max_lost_frames = cfg.get_or<int>("target.points.max_lost_frames", t.point_max_lost_frames);
+  t.init_mode = target::parse_init_mode(cfg.get_or<std::string>("target.init.mode", target::to_string(t.init_mode)));
+  t.feature_init.frames = cfg.get_or<int>("target.init.frames", t.feature_init.frames);
+  t.feature_init.min_points = cfg.get_or<int>("target.init.min_points", t.feature_init.min_points);
+  t.feature_init.max_point_distance =
+      cfg.get_or<double>("target.init.max_point_distance", t.feature_init.max_point_distance);
+  t.feature_init.sigma_w = cfg.get_or<double>("target.init.sigma_w", t.feature_init.sigma_w);
   t.init_sigmas.theta = cfg.get_or<double>("target.init_sigmas.theta", t.init_sigmas.theta);
   t.init_sigmas.p = cfg.get_or<double>("target.init_sigmas.p", t.init_sigmas.p);
   t.init_sigmas.v = cfg.get_or<double>("target.init_sigmas.v", t.init_sigmas.v);
@@ -113,7 +119,7 @@ TargetFilterNode::TargetFilterNode(const TargetFilterNodeOptions& options, Callb
             if (callbacks_.on_event) callbacks_.on_event(e);
           }) {
   if (options_.target_enabled) {
-    // The target starts from the truth with the robot's perturbation seed, as in vimot-target-eval.
+    // A start from the truth is perturbed with the robot's seed, as in vimot-target-eval.
     target::TargetFilterOptions target = options_.target;
     target.init_perturb_seed = options_.perturb_seed;
     filter_ = std::make_unique<target::TargetFilter>(vins_.mutable_estimator(), target);
@@ -130,7 +136,7 @@ void TargetFilterNode::on_frame(const CameraFrame& frame) { vins_.on_frame(frame
 void TargetFilterNode::flush() { vins_.flush(); }
 
 void TargetFilterNode::on_ground_truth(const GroundTruth& truth) {
-  if (filter_ && truth.has_target) {
+  if (filter_ && truth.has_target && options_.target.init_mode == target::TargetInitMode::kGroundTruth) {
     truths_[truth.utime] = truth;
     const int64_t keep_from = truth.utime - static_cast<int64_t>(options_.ground_truth_buffer_s * 1e6);
     while (!truths_.empty() && truths_.begin()->first < keep_from) truths_.erase(truths_.begin());

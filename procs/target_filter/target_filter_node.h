@@ -11,9 +11,10 @@
 //   * once the target is initialised: the target state (TARGET_STATE) and its
 //     prediction prediction_horizon_s ahead (TARGET_PREDICTION) — also for
 //     frames without target observations (the target is then only predicted).
-// Initialisation (simulation): the robot from the first GROUND_TRUTH message
-// (as vins), the target from the ground truth at the utime of the first frame
-// with target observations (ground truth is buffered by utime for that).
+// Initialisation: the robot as vins does; the target from its own features
+// (target.init.mode features, no ground truth) or, in simulation, from the
+// ground truth at the utime of the first frame with target observations
+// (init.mode ground_truth: ground truth is buffered by utime for that).
 
 #include <cstdint>
 #include <functional>
@@ -59,7 +60,8 @@ struct TargetFilterNodeOptions {
 ///   target: (keys of vimot-target-eval's file, absent keys keep
 ///     TargetFilterOptions' defaults) mode skf | ekf | off | none (none: no
 ///     filter attached), representation local | global, sigma_t, planar,
-///     chi2_multiplier, min_clone_times, init_sigmas.{theta,p,v,w},
+///     chi2_multiplier, min_clone_times, init.{mode, frames,
+///     min_points, max_point_distance, sigma_w}, init_sigmas.{theta,p,v,w},
 ///     points.{max,init_clone_times,max_lost_frames}, prediction_horizon_s.
 /// Throws std::invalid_argument (or the Config's error) on a bad value.
 TargetFilterNodeOptions node_options_from_config(const Config& cfg);

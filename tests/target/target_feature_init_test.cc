@@ -1,0 +1,147 @@
+// The target filter started from its own target features (init mode
+// features, common/target/target_filter.h) on the simulator's paper
+// scenario: the filter never sees the ground truth. The test uses the truth
+// only to evaluate, through the fixed transform between the filter's target
+// frame and the true one (common/eval/target_frame.h), as the evaluators do.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/config/config.h"
+#include "common/estimator/state_helper.h"
+#include "common/estimator/vio_estimator.h"
+#include "common/eval/initial_estimate.h"
+#include "common/eval/metrics.h"
+#include "common/eval/target_frame.h"
+#include "common/eval/vins_config.h"
+#include "common/math/quat.h"
+#include "common/sim/sim_config.h"
+#include "common/sim/simulator.h"
+#include "common/target/target_conversion.h"
+#include "common/target/target_filter.h"
+
+using namespace vimot;
+using namespace vimot::estimator;
+using namespace vimot::target;
+
+namespace {
+
+std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
+
+struct Run {
+  bool diverged{false};
+  int64_t first_target_frame{-1};  // index of the first processed frame with target observations
+  int64_t init_frame{-1};          // index of the frame the filter initialised at
+  std::optional<TargetFeatureInitInfo> init;
+  eval::TargetFrameTransform X;
+  GroundTruth truth_at_init;
+  Eigen::Matrix3d robot_theta_cov_at_init{Eigen::Matrix3d::Zero()};
+  // Target in IMU after the fixed transform, every frame after initialisation.
+  std::vector<eval::ErrorSample> samples;
+  TargetUpdateStats stats;
+};
+
+Run run(uint64_t seed, double duration, TargetRepresentation rep = TargetRepresentation::kLocal) {
+  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
+  cfg.seed = seed;
+  cfg.duration = duration;
+  cfg.ground_truth_events = true;
+  sim::Simulator sim(cfg);
+  const VioOptions vo = eval::load_vio_options(source_path("config/vins.yaml"));
+  VioEstimator est(vo);
+  // The robot's own start (vins' simulation start: the perturbed truth); the
+  // target filter gets no ground truth at all.
+  const eval::InitialEstimate x0 = eval::initial_estimate(sim.initial_state(), vo, eval::perturb_seed_for_run(seed));
+  est.initialize(x0.value, sim.initial_state().utime, x0.P0);
+  TargetFilterOptions o;
+  o.init_mode = TargetInitMode::kFeatures;
+  o.representation = rep;
+  o.sigma_t = 0.05;
+  TargetFilter filter(est, o);
+
+  Run out;
+  GroundTruth truth;
+  int64_t frame = -1;
+  const bool trace = std::getenv("DIAG_TRACE") != nullptr;
+  while (std::optional<sim::SimEvent> ev = sim.next()) {
+    if (const auto* imu = std::get_if<ImuData>(&*ev)) {
+      est.feed_imu(*imu);
+      continue;
+    }
+    if (const auto* gt = std::get_if<GroundTruth>(&*ev)) {
+      truth = *gt;
+      continue;
+    }
+    const auto& cam = std::get<CameraFrame>(*ev);
+    const bool was_initialized = filter.initialized();
+    const FrameStatus s = est.feed_camera(cam);
+    if (s == FrameStatus::kDiverged) {
+      out.diverged = true;
+      break;
+    }
+    if (s != FrameStatus::kProcessed) continue;
+    ++frame;
+    bool has_target = false;
+    for (const auto& ob : cam.observations) has_target = has_target || ob.is_target;
+    if (has_target && out.first_target_frame < 0) out.first_target_frame = frame;
+    if (!filter.initialized() || truth.utime != cam.utime || !truth.has_target) continue;
+    const State& st = est.state();
+    const PoseValue ip = imu_pose(est.imu_value());
+    const Eigen::Matrix<double, 18, 18> P18 =
+        StateHelper::marginal_covariance(st, {st.imu()->pose()->q(), st.imu()->pose()->p(), filter.target()});
+    TargetValue x_i = filter.value();
+    Matrix12d P_i = P18.block<12, 12>(6, 6);
+    if (rep == TargetRepresentation::kGlobal) {
+      x_i = global_to_local(ip, filter.value());
+      P_i = global_to_local_covariance(ip, filter.value(), P18);
+    }
+    if (!was_initialized) {
+      out.init_frame = frame;
+      out.init = filter.feature_init_info();
+      out.X = eval::target_frame_transform(truth, x_i.q_RtoT, x_i.p_TinR);
+      out.truth_at_init = truth;
+      out.robot_theta_cov_at_init = P18.block<3, 3>(0, 0);
+    }
+    const GroundTruth t = eval::in_target_frame(truth, out.X);
+    const eval::TargetInImu ti = eval::true_target_in_imu(t);
+    out.samples.push_back(eval::compute_error(cam.utime, ti.q_ItoT, ti.p_TinI, x_i.q_RtoT, x_i.p_TinR,
+                                              P_i.block<3, 3>(0, 0), P_i.block<3, 3>(3, 3)));
+    if (trace && frame % 10 == 0) {
+      const eval::ErrorSample& e = out.samples.back();
+      std::printf("  f %lld err p [%.3f %.3f %.3f] th(deg) [%.2f %.2f %.2f] nees %.2f/%.2f v [%.2f %.2f %.2f] true "
+                  "[%.2f %.2f %.2f] w %.3f true %.3f pts %zu\n",
+                  static_cast<long long>(frame), e.err_p.x(), e.err_p.y(), e.err_p.z(), e.err_theta.x() * 57.3,
+                  e.err_theta.y() * 57.3, e.err_theta.z() * 57.3, e.nees_p, e.nees_theta, x_i.v_TinT.x(),
+                  x_i.v_TinT.y(), x_i.v_TinT.z(), t.v_TinT.x(), t.v_TinT.y(), t.v_TinT.z(), x_i.w_TinT.z(),
+                  t.w_TinT.z(), filter.points().size());
+    }
+  }
+  out.stats = filter.stats();
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("features start: diagnostics", "[.diag]") {
+  const char* env_seeds = std::getenv("DIAG_SEEDS");
+  const int nseeds = env_seeds ? std::atoi(env_seeds) : 1;
+  const TargetRepresentation rep = std::getenv("DIAG_GLOBAL") ? TargetRepresentation::kGlobal
+                                                              : TargetRepresentation::kLocal;
+  for (int i = 0; i < nseeds; ++i) {
+    const Run r = run(3 + static_cast<uint64_t>(i), 20.0, rep);
+    eval::TrajectoryErrors e;
+    for (const auto& s : r.samples) e.add(s);
+    const eval::ErrorSummary sum = e.summary();
+    std::printf("seed %d: init frame %lld (target from %lld), %zu points, X %s | RMSE %.4f m %.3f deg NEES %.2f / %.2f\n",
+                3 + i, static_cast<long long>(r.init_frame), static_cast<long long>(r.first_target_frame),
+                r.init ? r.init->feature_ids.size() : 0, r.X.describe().c_str(), sum.rmse_position_m,
+                sum.rmse_orientation_deg, sum.nees_position, sum.nees_orientation);
+  }
+}
