@@ -43,6 +43,7 @@ struct Run {
   eval::TargetFrameTransform X;
   GroundTruth truth_at_init;
   Eigen::Matrix3d robot_theta_cov_at_init{Eigen::Matrix3d::Zero()};
+  Eigen::Vector3d true_centroid_in_T{Eigen::Vector3d::Zero()};
   // Target in IMU after the fixed transform, every frame after initialisation.
   std::vector<eval::ErrorSample> samples;
   TargetUpdateStats stats;
@@ -124,10 +125,104 @@ Run run(uint64_t seed, double duration, TargetRepresentation rep = TargetReprese
     }
   }
   out.stats = filter.stats();
+  if (out.init) {
+    // The true centroid, in T, of the body points the filter put its origin at.
+    for (const int64_t id : out.init->feature_ids) {
+      out.true_centroid_in_T += sim.landmarks().at(static_cast<size_t>(sim.landmark_of_feature(id))).p;
+    }
+    out.true_centroid_in_T /= static_cast<double>(out.init->feature_ids.size());
+  }
   return out;
 }
 
 }  // namespace
+
+TEST_CASE("features start: no ground truth, started within its window, tracked consistently", "[target_filter]") {
+  const TargetFeatureInit defaults;
+  // Per run: mean NEES of the target-in-IMU position and orientation.
+  std::vector<double> nees_p, nees_theta;
+  for (const uint64_t seed : {1, 2, 3, 4}) {
+    const Run r = run(seed, 20.0);
+    eval::TrajectoryErrors e;
+    for (const auto& s : r.samples) e.add(s);
+    const eval::ErrorSummary sum = e.summary();
+    INFO("seed " << seed << ": init frame " << r.init_frame << " (target from " << r.first_target_frame << "), X "
+                 << r.X.describe() << ", RMSE " << sum.rmse_position_m << " m (predicted "
+                 << sum.predicted_rmse_position_m << ") " << sum.rmse_orientation_deg << " deg (predicted "
+                 << sum.predicted_rmse_orientation_deg << "), NEES " << sum.nees_position << " / "
+                 << sum.nees_orientation);
+    REQUIRE_FALSE(r.diverged);
+    REQUIRE(r.init);
+    REQUIRE(r.first_target_frame >= 0);
+    // The paper scenario keeps the target in view with ~40 stereo target
+    // features a frame, far above min_points, so the start takes exactly its
+    // window of consecutive frames.
+    CHECK(r.init_frame - r.first_target_frame == defaults.frames - 1);
+    CHECK(static_cast<int>(r.init->feature_ids.size()) >= defaults.min_points);
+
+    // The reported transform is what the start prescribes: the filter's axes
+    // are those of its G (X ≈ R_TtoG, off by the robot's orientation error),
+    // its origin the centroid of those features (off by their triangulation
+    // error).
+    const Eigen::Vector4d q_TtoG = quat_inverse(r.truth_at_init.q_GtoT);
+    CHECK(eval::orientation_error(r.X.q_TtoTest, q_TtoG).norm() < 3.0 * std::sqrt(r.robot_theta_cov_at_init.trace()));
+    CHECK((r.X.p_TestInT - r.true_centroid_in_T).norm() < 3.0 * std::sqrt(r.init->centroid_cov.trace()));
+
+    // Tracked over the run: the RMSE within 3× what the filter's covariance
+    // predicts, and the last error inside 3σ on every axis.
+    REQUIRE(r.samples.size() > 150);
+    CHECK(sum.rmse_position_m < 3.0 * sum.predicted_rmse_position_m);
+    CHECK(sum.rmse_orientation_deg < 3.0 * sum.predicted_rmse_orientation_deg);
+    const eval::ErrorSample& last = r.samples.back();
+    for (int k = 0; k < 3; ++k) CHECK(std::abs(last.err_p(k)) < last.sig3_p(k));
+    CHECK(r.stats.points_initialized > 0);
+    nees_p.push_back(sum.nees_position);
+    nees_theta.push_back(sum.nees_orientation);
+  }
+  // Not overconfident: the mean over the 4 runs of the run-averaged NEES
+  // (3 dof) below the upper end of the two-sided 95 % band of χ²(12)/4,
+  // 23.34/4, as if each run gave one χ²(3) draw (a time average spreads
+  // less, so this is the looser bound). The lower end (4.40/4) is not met in
+  // position (measured 0.93): the filter is conservative there, as it is when
+  // started from the truth (docs/target_model.md, "Target points in the
+  // state": mean 1.29 over seeds 3–8), and the transform zeroes the first
+  // error while the covariance starts at the gauge prior; so only the
+  // orientation gets the lower bound. Measured: docs/target_model.md,
+  // "Start from the target's features".
+  double mp = 0.0, mt = 0.0;
+  for (std::size_t i = 0; i < nees_p.size(); ++i) {
+    mp += nees_p[i] / static_cast<double>(nees_p.size());
+    mt += nees_theta[i] / static_cast<double>(nees_theta.size());
+  }
+  INFO("mean NEES position " << mp << ", orientation " << mt);
+  CHECK(mp < 23.34 / 4.0);
+  CHECK(mt > 4.40 / 4.0);
+  CHECK(mt < 23.34 / 4.0);
+}
+
+TEST_CASE("features start: global representation, correlated with the robot", "[target_filter]") {
+  const Run r = run(1, 10.0, TargetRepresentation::kGlobal);
+  REQUIRE_FALSE(r.diverged);
+  REQUIRE(r.init);
+  REQUIRE(r.samples.size() > 50);
+  eval::TrajectoryErrors e;
+  for (const auto& s : r.samples) e.add(s);
+  const eval::ErrorSummary sum = e.summary();
+  INFO("RMSE " << sum.rmse_position_m << " m (predicted " << sum.predicted_rmse_position_m << "), NEES "
+               << sum.nees_position << " / " << sum.nees_orientation);
+  // Target-in-IMU through the global state and the robot's covariance: the
+  // first sample's error is zero by the transform's construction, and its
+  // covariance is the gauge prior only if the cross-covariance with the
+  // robot cancels the robot's part (δx_L = δx_G − J δx_I).
+  const TargetFilterOptions defaults;
+  const eval::ErrorSample& first = r.samples.front();
+  CHECK(first.err_p.norm() < 1e-9);
+  CHECK(first.sig3_p.maxCoeff() < 3.0 * defaults.init_sigmas.p * (1.0 + 1e-6));
+  CHECK(first.sig3_theta.maxCoeff() < 3.0 * defaults.init_sigmas.theta * (1.0 + 1e-6));
+  CHECK(sum.rmse_position_m < 3.0 * sum.predicted_rmse_position_m);
+  const eval::ErrorSample& last = r.samples.back();
+  for (int k = 0; k < 3; ++k) CHECK(std::abs(last.err_p(k)) < last.sig3_p(k));
+}
 
 TEST_CASE("features start: diagnostics", "[.diag]") {
   const char* env_seeds = std::getenv("DIAG_SEEDS");
