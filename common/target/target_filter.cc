@@ -450,9 +450,10 @@ bool TargetFilter::initialize_from_features(State& state, int64_t utime, const s
 
 void TargetFilter::update(State& state, int64_t utime, const std::vector<FeatureObservation>& obs) {
   if (!target_) {
-    if (obs.empty()) return;
-    const bool started = options_.init_mode == TargetInitMode::kGroundTruth ? initialize_from_truth(state, utime)
-                                                                            : initialize_from_features(state, utime, obs);
+    // (A frame without target features also breaks the features start's window.)
+    const bool started = options_.init_mode == TargetInitMode::kGroundTruth
+                             ? !obs.empty() && initialize_from_truth(state, utime)
+                             : initialize_from_features(state, utime, obs);
     if (!started) return;
   }
   if (options_.mode == TargetUpdateMode::kOff) return;

@@ -6,9 +6,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,7 +51,9 @@ struct Run {
   TargetUpdateStats stats;
 };
 
-Run run(uint64_t seed, double duration, TargetRepresentation rep = TargetRepresentation::kLocal) {
+// edit: applied to every camera frame (by its index) before the estimator sees it.
+Run run(uint64_t seed, double duration, TargetRepresentation rep = TargetRepresentation::kLocal,
+        const std::function<void(int64_t, CameraFrame&)>& edit = {}) {
   sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
   cfg.seed = seed;
   cfg.duration = duration;
@@ -70,6 +74,7 @@ Run run(uint64_t seed, double duration, TargetRepresentation rep = TargetReprese
   Run out;
   GroundTruth truth;
   int64_t frame = -1;
+  int64_t frames_seen = 0;
   const bool trace = std::getenv("DIAG_TRACE") != nullptr;
   while (std::optional<sim::SimEvent> ev = sim.next()) {
     if (const auto* imu = std::get_if<ImuData>(&*ev)) {
@@ -80,7 +85,9 @@ Run run(uint64_t seed, double duration, TargetRepresentation rep = TargetReprese
       truth = *gt;
       continue;
     }
-    const auto& cam = std::get<CameraFrame>(*ev);
+    auto& cam = std::get<CameraFrame>(*ev);
+    if (edit) edit(frames_seen, cam);
+    ++frames_seen;
     const bool was_initialized = filter.initialized();
     const FrameStatus s = est.feed_camera(cam);
     if (s == FrameStatus::kDiverged) {
@@ -198,6 +205,21 @@ TEST_CASE("features start: no ground truth, started within its window, tracked c
   CHECK(mp < 23.34 / 4.0);
   CHECK(mt > 4.40 / 4.0);
   CHECK(mt < 23.34 / 4.0);
+}
+
+TEST_CASE("features start: a frame without target features restarts the window", "[target_filter]") {
+  const TargetFeatureInit defaults;
+  const Run r = run(1, 3.0, TargetRepresentation::kLocal, [](int64_t i, CameraFrame& f) {
+    if (i != 2) return;
+    auto& obs = f.observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(), [](const FeatureObservation& o) { return o.is_target; }),
+              obs.end());
+  });
+  REQUIRE_FALSE(r.diverged);
+  REQUIRE(r.first_target_frame == 0);
+  REQUIRE(r.init);
+  // Frames 0–1 are lost with the gap at 2; the window is frames 3 to 3 + frames − 1.
+  CHECK(r.init_frame == 3 + defaults.frames - 1);
 }
 
 TEST_CASE("features start: global representation, correlated with the robot", "[target_filter]") {
