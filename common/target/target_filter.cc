@@ -258,8 +258,8 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
     // The true relative pose (robot-centric truth).
     x = global_to_local(PoseValue{truth_->q_GtoI, truth_->p_IinG}, global);
   }
-  target_ = std::make_shared<TargetState>();
-  target_->set_value(x.to_vector());
+  TargetState start;
+  start.set_value(x.to_vector());
   const TargetInitSigmas& s = options_.init_sigmas;
   Vector12d sigma;
   sigma << Eigen::Vector3d::Constant(s.theta), Eigen::Vector3d::Constant(s.p), Eigen::Vector3d::Constant(s.v),
@@ -270,11 +270,9 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
     std::normal_distribution<double> n01(0.0, 1.0);
     Vector12d dx;
     for (int i = 0; i < 12; ++i) dx(i) = sigma(i) * n01(rng);
-    target_->update(dx);
+    start.update(dx);
   }
-  target_->set_fej(target_->value());
-  StateHelper::add_variable(state, target_, Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()));
-  if (state.clone_at(utime)) on_clone_added(state, utime);
+  add_target(state, utime, start.get(), sigma.cwiseAbs2().asDiagonal(), Eigen::MatrixXd());
   return true;
 }
 

@@ -43,20 +43,22 @@
 // points anchor the T origin across windows, which MSCKF-only target updates
 // cannot (docs/target_model.md). Target points are target (active) variables
 // under kSkf. The MSCKF-style update above stays for the other tracks.
-// Initialisation (init_mode):
-//   kFeatures (default, no ground truth): at the first frame with at least
-//     feature_init.min_points target features seen by two cameras, each is
-//     triangulated in I from that stereo pair alone (the target moves, so
-//     only simultaneous views can be used) and the target frame T is
-//     *defined* there: origin at the points' centroid, axes parallel to the
-//     estimated G (R_GtoT = I: z up, as the planar model needs), v = w = 0
-//     with the broad prior feature_init.sigma_{v,w}. T is body-fixed to the
-//     target and otherwise arbitrary (its pose relative to its points is a
-//     gauge, docs/target_model.md), so the pose part gets only the small
-//     init_sigmas.{theta,p} that fixes the gauge relative to the robot at
-//     that time: in the local representation it is independent of the robot;
-//     the global one is its image through local_to_global, so its covariance
-//     and cross-covariance with the robot follow from that map's Jacobians.
+// Initialisation (init_mode; docs/target_model.md, "Start from the target's
+// features"):
+//   kFeatures (default, no ground truth): once feature_init.frames
+//     consecutive frames each have at least feature_init.min_points target
+//     features seen by two cameras (triangulated in I from that stereo pair
+//     alone: the target moves), the features seen in all of them give a
+//     centroid per frame, placed in G with the robot's estimate then. T is
+//     *defined* at the last frame: origin at the centroid, axes those of G
+//     (R_GtoT = I: z up, as the planar model needs), v_TinT = the centroids'
+//     least-squares slope, w = 0. T's pose relative to its points is a gauge,
+//     so its start pose gets only the small init_sigmas.{theta,p} fixing it
+//     relative to the robot; v gets the slope's noise plus the robot's
+//     velocity error, w feature_init.sigma_w (init_sigmas.w on the axes the
+//     planar model does not drive). The cross-covariance with the robot is
+//     that of this start function's Jacobian (global: composed with
+//     local_to_global's), as a delayed initialisation.
 //   kGroundTruth (simulation, the paper's convention): from the ground truth
 //     at the first frame with target observations (set_ground_truth() before
 //     feed_camera), with the prior init_sigmas (uncorrelated with the robot).
