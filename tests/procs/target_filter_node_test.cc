@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "common/config/config.h"
+#include "common/eval/target_eval.h"
 #include "common/eval/truth_matcher.h"
 #include "common/eval/vins_config.h"
 #include "common/math/quat.h"
@@ -255,4 +256,22 @@ TEST_CASE("target filter node starts the target from its features without ground
   INFO("p_TinI error " << last.err_p.transpose() << ", sigma " << P.diagonal().cwiseSqrt().transpose());
   for (int k = 0; k < 3; ++k) CHECK(std::abs(last.err_p(k)) < 3.0 * std::sqrt(P(k, k)));
   CHECK(out.target.back().num_target_points > 0);
+
+  // The offline evaluator (vimot-target-eval's run, same seeds, same start)
+  // gives the same figures and the same transform: "LCM = offline" holds for
+  // the features start too.
+  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
+  cfg.seed = 5;  // simulate()'s
+  cfg.duration = 6.0;
+  const eval::TargetRunResult offline =
+      eval::run_target_on_sim(cfg, options.vio, options.target, options.perturb_seed);
+  REQUIRE_FALSE(offline.diverged);
+  eval::TrajectoryErrors node_errors;
+  for (const eval::ErrorSample& e : m.target_in_imu) node_errors.add(e);
+  const eval::ErrorSummary node_summary = node_errors.summary();
+  CHECK(offline.target_in_imu.count == node_summary.count);
+  CHECK(offline.target_in_imu.rmse_position_m == Approx(node_summary.rmse_position_m).epsilon(1e-9));
+  CHECK(offline.target_in_imu.rmse_orientation_deg == Approx(node_summary.rmse_orientation_deg).epsilon(1e-9));
+  CHECK(offline.target_in_imu.nees_position == Approx(node_summary.nees_position).epsilon(1e-9));
+  CHECK((offline.target_frame.p_TestInT - m.target_frame.p_TestInT).norm() < 1e-12);
 }
