@@ -100,17 +100,21 @@ double max_nav_difference(const std::vector<NavState>& a, const std::vector<NavS
 
 TEST_CASE("target filter node under SKF publishes exactly the VIO-only robot states", "[target_filter]") {
   const std::vector<sim::SimEvent> events = simulate(6.0);
-  for (const auto rep : {target::TargetRepresentation::kLocal, target::TargetRepresentation::kGlobal}) {
-    TargetFilterNodeOptions options = node_options();
-    options.target.mode = target::TargetUpdateMode::kSkf;
-    options.target.representation = rep;
-    const Outputs out = run_node(events, options);
-    const std::vector<NavState> vins = run_vins(events, options);
-    REQUIRE(vins.size() >= 50);
-    REQUIRE(!out.target.empty());
-    CHECK(out.target.back().num_target_points > 0);  // target updates did happen
-    INFO("representation " << target::to_string(rep));
-    CHECK(max_nav_difference(out.nav, vins) < 1e-9);
+  // Both starts: the features start adds the target correlated with the robot.
+  for (const auto init : {target::TargetInitMode::kGroundTruth, target::TargetInitMode::kFeatures}) {
+    for (const auto rep : {target::TargetRepresentation::kLocal, target::TargetRepresentation::kGlobal}) {
+      TargetFilterNodeOptions options = node_options();
+      options.target.init_mode = init;
+      options.target.mode = target::TargetUpdateMode::kSkf;
+      options.target.representation = rep;
+      const Outputs out = run_node(events, options);
+      const std::vector<NavState> vins = run_vins(events, options);
+      REQUIRE(vins.size() >= 50);
+      REQUIRE(!out.target.empty());
+      CHECK(out.target.back().num_target_points > 0);  // target updates did happen
+      INFO("start " << target::to_string(init) << ", representation " << target::to_string(rep));
+      CHECK(max_nav_difference(out.nav, vins) < 1e-9);
+    }
   }
 }
 
