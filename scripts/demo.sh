@@ -136,12 +136,15 @@ echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal
 echo "== target accuracy of the LCM run (TARGET_STATE vs GROUND_TRUTH), and the offline run:"
 target_cfg="$VIMOT_CONFIG/target_filter.yaml"
 target_key() { sed -n "s/^  $1: *\([a-z0-9.]*\).*/\1/p" "$target_cfg" | head -n 1; }
+# init.mode features: the filter's own target frame, compared through the fixed transform.
+own_frame=""
+if sed -n '/^  init:/,/^  [a-z_]*:/p' "$target_cfg" | grep -q '^    mode: *features'; then own_frame="--own-target-frame"; fi
 "$VIMOT_BIN/vimot-target-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
   --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-config "$target_cfg" \
   --modes "$(target_key mode)" --representations "$(target_key representation)" \
   --sigmas "$(target_key sigma_t)" --no-vio-only --runs 1 --first-seed "$VIMOT_SEED" \
   --perturb-seed "${perturb_seed:-0}" --out "$out/offline_target" --quiet > "$out/offline_target.txt" 2>&1 || true
-"$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE \
+"$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE $own_frame \
   --compare-target "$out/offline_target/summary.json" | grep -E '^(target|compare|  target)' | sed 's/^/   /'
 echo "   (offline target run: $out/offline_target.txt)"
 echo "== log: $VIMOT_LOG"

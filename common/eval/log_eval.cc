@@ -60,7 +60,7 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   for (const ErrorSample& s : r.samples) errors.add(s);
   r.summary = errors.summary();
   if (!options.target_channel.empty()) {
-    r.target_samples = matcher.match_targets(&r.target_counts);
+    r.target_samples = matcher.match_targets(&r.target_counts, options.target_own_frame);
     TrajectoryErrors in_imu, in_world;
     for (const ErrorSample& s : r.target_samples.target_in_imu) in_imu.add(s);
     for (const ErrorSample& s : r.target_samples.target_in_world) in_world.add(s);

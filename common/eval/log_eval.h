@@ -21,6 +21,9 @@ struct LogEvalOptions {
   std::string state_channel{"VINS_STATE"};
   std::string truth_channel{"GROUND_TRUTH"};
   std::string target_channel;  // target_state_t; empty: no target evaluation
+  /// The target filter started from its features (its own target frame):
+  /// compare through the fixed transform at its first state (TruthMatcher).
+  bool target_own_frame{false};
   // Monocular scale pipeline: scale_estimate_t and metric_object_pose_t
   // against the truth of the tracker's tracks (from vimot-scale-eval's
   // summary.json of the same seed: the object frame O is defined by the

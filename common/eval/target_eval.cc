@@ -102,10 +102,15 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
           x_i = target::global_to_local(ip, x);
           P_i = target::global_to_local_covariance(ip, x, P18);
         }
-        const TargetInImu truth_in_imu = true_target_in_imu(truth);
+        // A frame of the filter's own (features start): fixed at its first estimate.
+        if (e_ti.count() == 0 && filter->options().init_mode == target::TargetInitMode::kFeatures) {
+          r.target_frame = target_frame_transform(truth, x_i.q_RtoT, x_i.p_TinR);
+        }
+        const GroundTruth t = in_target_frame(truth, r.target_frame);
+        const TargetInImu truth_in_imu = true_target_in_imu(t);
         const ErrorSample ti = compute_error(frame.utime, truth_in_imu.q_ItoT, truth_in_imu.p_TinI, x_i.q_RtoT, x_i.p_TinR,
                                              P_i.block<3, 3>(0, 0), P_i.block<3, 3>(3, 3));
-        const ErrorSample tg = compute_error(frame.utime, truth.q_GtoT, truth.p_TinG, x_g.q_RtoT, x_g.p_TinR,
+        const ErrorSample tg = compute_error(frame.utime, t.q_GtoT, t.p_TinG, x_g.q_RtoT, x_g.p_TinR,
                                              P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3));
         e_ti.add(ti);
         e_tg.add(tg);
@@ -354,6 +359,17 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
       j.begin_object();
       j.field("sim_seed", r.sim_seed).field("perturb_seed", r.perturb_seed).field("diverged", r.diverged);
       if (r.diverged) j.field("divergence_reason", r.divergence_reason);
+      if (!c.vio_only) {
+        j.key("target_frame").begin_object();
+        j.field("angle_deg", r.target_frame.angle_deg());
+        j.key("q_TtoTest").begin_array();
+        for (int k = 0; k < 4; ++k) j.value(r.target_frame.q_TtoTest(k));
+        j.end_array();
+        j.key("p_TestInT").begin_array();
+        for (int k = 0; k < 3; ++k) j.value(r.target_frame.p_TestInT(k));
+        j.end_array();
+        j.end_object();
+      }
       j.key("target_in_imu");
       write_summary_json(j, r.target_in_imu);
       j.key("target_in_world");

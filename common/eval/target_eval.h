@@ -8,9 +8,13 @@
 // One run is run_vio_on_sim's run (same simulator, same perturbed IMU start
 // initial_estimate(..., perturb_seed)) with a TargetFilter attached (none
 // for the VIO-only row); before every camera frame the filter gets the
-// GroundTruth of that utime (set_ground_truth), so the target is
-// initialised from the truth at the first frame with target observations,
-// as in tests/target/target_filter_test.cc. Samples: every processed frame
+// GroundTruth of that utime (set_ground_truth), which it uses only with
+// init mode ground_truth (the target initialised from the truth at the
+// first frame with target observations, as in
+// tests/target/target_filter_test.cc); with init mode features the filter
+// starts from its own target features and the truth is taken in the
+// filter's target frame (target_frame.h, fixed at the filter's first
+// estimate, reported in TargetRunResult::target_frame). Samples: every processed frame
 // with truth at or after the first frame with target observations (the
 // same frames with and without the filter); the target errors only once the
 // filter is initialised. Per sample (error conventions of metrics.h, the
@@ -32,6 +36,7 @@
 #include "common/config/config.h"
 #include "common/eval/metrics.h"
 #include "common/eval/sim_runner.h"
+#include "common/eval/target_frame.h"
 #include "common/target/target_filter.h"
 
 namespace vimot {
@@ -49,6 +54,9 @@ struct TargetRunResult {
   ErrorSummary target_in_world;  // [q_GtoT, p_TinG]
   ErrorSummary imu;              // [q_GtoI, p_IinG]
   bool target_initialized{false};
+  /// The filter's target frame in the true one, fixed at its first estimate
+  /// (init mode features); identity for the start from the truth.
+  TargetFrameTransform target_frame;
   int64_t frames_processed{0};
   bool diverged{false};
   std::string divergence_reason;

@@ -65,7 +65,7 @@ ErrorSample error_without_covariance(int64_t utime, const Eigen::Vector4d& q_tru
 
 }  // namespace
 
-TargetMatch TruthMatcher::match_targets(TargetMatchCounts* counts) const {
+TargetMatch TruthMatcher::match_targets(TargetMatchCounts* counts, bool own_frame) const {
   TargetMatchCounts c = target_counts_;
   TargetMatch out;
   for (const auto& [utime, est] : targets_) {
@@ -74,8 +74,9 @@ TargetMatch TruthMatcher::match_targets(TargetMatchCounts* counts) const {
       ++c.unmatched;
       continue;
     }
+    if (own_frame && c.matched == 0) out.target_frame = target_frame_transform(it->second, est.q_ItoT, est.p_TinI);
     ++c.matched;
-    const GroundTruth& t = it->second;
+    const GroundTruth t = in_target_frame(it->second, out.target_frame);
     const TargetInImu truth_in_imu = true_target_in_imu(t);
     const Eigen::Vector4d& q_ItoT_true = truth_in_imu.q_ItoT;
     const Eigen::Vector3d& p_TinI_true = truth_in_imu.p_TinI;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/eval/metrics.h"
+#include "common/eval/target_frame.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
 #include "common/types/target_state.h"
@@ -43,6 +44,8 @@ struct TargetMatchCounts {
 struct TargetMatch {
   std::vector<ErrorSample> target_in_imu;    // [q_ItoT, p_TinI]
   std::vector<ErrorSample> target_in_world;  // [q_GtoT, p_TinG]
+  /// The filter's target frame in the true one (identity unless own_frame).
+  TargetFrameTransform target_frame;
 };
 
 class TruthMatcher {
@@ -53,7 +56,10 @@ class TruthMatcher {
 
   /// Matches everything given so far; samples in utime order.
   std::vector<ErrorSample> match(MatchCounts* counts) const;
-  TargetMatch match_targets(TargetMatchCounts* counts) const;
+  /// own_frame: the filter defined its own target frame (init mode
+  /// features); the truth is taken in it, through the fixed transform at the
+  /// first matched target state (target_frame.h).
+  TargetMatch match_targets(TargetMatchCounts* counts, bool own_frame = false) const;
 
  private:
   std::map<int64_t, NavState> states_;  // updated states by utime

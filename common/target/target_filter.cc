@@ -118,6 +118,14 @@ const char* to_string(TargetUpdateMode mode) {
   return "unknown";
 }
 
+const char* to_string(TargetInitMode mode) {
+  switch (mode) {
+    case TargetInitMode::kFeatures: return "features";
+    case TargetInitMode::kGroundTruth: return "ground_truth";
+  }
+  return "unknown";
+}
+
 TargetNoise TargetFilterOptions::noise() const {
   return planar ? TargetNoise::planar(sigma_t, sigma_t) : TargetNoise::isotropic(sigma_t, sigma_t);
 }
@@ -132,6 +140,11 @@ TargetFilter::TargetFilter(estimator::VioEstimator& estimator, const TargetFilte
     throw std::invalid_argument("TargetFilterOptions: need max_target_points >= 0, point_init_clone_times >= 2 and "
                                 "point_max_lost_frames >= 1");
   }
+  const TargetFeatureInit& fi = options_.feature_init;
+  if (fi.frames < 2 || fi.min_points < 1 || !(fi.max_point_distance > 0.0) || !(fi.sigma_w > 0.0)) {
+    throw std::invalid_argument("TargetFilterOptions: feature_init needs frames >= 2, min_points >= 1 and "
+                                "max_point_distance, sigma_w > 0");
+  }
   estimator_.set_extension(this);
 }
 
@@ -145,6 +158,8 @@ void TargetFilter::reset() {
   pending_.reset();
   tracks_.clear();
   points_.clear();
+  feature_init_info_.reset();
+  init_window_.clear();
   frame_ = 0;
 }
 
@@ -237,8 +252,8 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
     // The true relative pose (robot-centric truth).
     x = global_to_local(PoseValue{truth_->q_GtoI, truth_->p_IinG}, global);
   }
-  target_ = std::make_shared<TargetState>();
-  target_->set_value(x.to_vector());
+  TargetState start;
+  start.set_value(x.to_vector());
   const TargetInitSigmas& s = options_.init_sigmas;
   Vector12d sigma;
   sigma << Eigen::Vector3d::Constant(s.theta), Eigen::Vector3d::Constant(s.p), Eigen::Vector3d::Constant(s.v),
@@ -249,17 +264,189 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
     std::normal_distribution<double> n01(0.0, 1.0);
     Vector12d dx;
     for (int i = 0; i < 12; ++i) dx(i) = sigma(i) * n01(rng);
-    target_->update(dx);
+    start.update(dx);
   }
-  target_->set_fej(target_->value());
-  StateHelper::add_variable(state, target_, Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()));
+  add_target(state, utime, start.get(), sigma.cwiseAbs2().asDiagonal(), Eigen::MatrixXd());
+  return true;
+}
+
+void TargetFilter::add_target(State& state, int64_t utime, const TargetValue& x, const Matrix12d& P_TT,
+                              const Eigen::MatrixXd& P_Tx) {
+  target_ = std::make_shared<TargetState>();
+  target_->set_value(x.to_vector());
+  target_->set_fej(x.to_vector());
+  StateHelper::add_variable(state, target_, P_TT, P_Tx);
   if (state.clone_at(utime)) on_clone_added(state, utime);
+}
+
+std::optional<TargetFilter::StereoPoints> TargetFilter::stereo_target_points(
+    const State& state, int64_t utime, const std::vector<FeatureObservation>& obs) const {
+  // Target features seen by at least two cameras now, triangulated in I from
+  // this frame alone (identity pose: the triangulator's "G" is I).
+  const auto& cameras = estimator_.cameras();
+  std::map<int64_t, estimator::Feature> by_id;
+  for (const auto& o : obs) {
+    if (o.camera_id < 0 || o.camera_id >= static_cast<int>(cameras.size())) continue;
+    estimator::Feature& f = by_id[o.feature_id];
+    f.feature_id = o.feature_id;
+    f.obs[o.camera_id].push_back(estimator::FeatureObs{utime, o.normalized});
+  }
+  const estimator::ClonePoses now{{utime, estimator::ClonePose{}}};
+  const estimator::FeatureTriangulator triangulator(options_.triangulation, cameras);
+  StereoPoints pts;
+  pts.utime = utime;
+  for (auto& kv : by_id) {
+    estimator::Feature& f = kv.second;
+    if (f.obs.size() < 2 || !triangulator.triangulate(f, now)) continue;
+    // Covariance from the whitened projection Jacobians of its views (Gauss–Newton information).
+    Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
+    for (const auto& cam_obs : f.obs) {
+      const estimator::CameraInfo& cam = cameras[static_cast<size_t>(cam_obs.first)];
+      const Eigen::Vector3d p_FinC = cam.R_ItoC * f.p_FinG + cam.p_IinC;
+      for (const auto& o : cam_obs.second) {
+        const Eigen::Matrix<double, 2, 3> H = cam.whitening(o.uv) * estimator::project_jacobian(p_FinC) * cam.R_ItoC;
+        info += H.transpose() * H;
+      }
+    }
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(info);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) continue;
+    pts.p_FinI[f.feature_id] = f.p_FinG;
+    pts.cov_I[f.feature_id] = ldlt.solve(Eigen::Matrix3d::Identity());
+  }
+  if (static_cast<int>(pts.p_FinI.size()) < options_.feature_init.min_points) return std::nullopt;
+  // Mismatched or mislabelled features: drop those far from the per-axis median.
+  Eigen::Vector3d median;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> c;
+    for (const auto& kv : pts.p_FinI) c.push_back(kv.second(k));
+    std::nth_element(c.begin(), c.begin() + static_cast<long>(c.size() / 2), c.end());
+    median(k) = c[c.size() / 2];
+  }
+  for (auto it = pts.p_FinI.begin(); it != pts.p_FinI.end();) {
+    if ((it->second - median).norm() > options_.feature_init.max_point_distance) {
+      pts.cov_I.erase(it->first);
+      it = pts.p_FinI.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  if (static_cast<int>(pts.p_FinI.size()) < options_.feature_init.min_points) return std::nullopt;
+  pts.imu = state.imu()->get();
+  return pts;
+}
+
+bool TargetFilter::initialize_from_features(State& state, int64_t utime, const std::vector<FeatureObservation>& obs) {
+  std::optional<StereoPoints> now = stereo_target_points(state, utime, obs);
+  if (!now) {
+    init_window_.clear();  // the frames of the window must be consecutive
+    return false;
+  }
+  init_window_.push_back(std::move(*now));
+  while (static_cast<int>(init_window_.size()) > options_.feature_init.frames) init_window_.pop_front();
+  if (static_cast<int>(init_window_.size()) < options_.feature_init.frames) return false;
+  // The features seen in every frame of the window: one fixed set of body points.
+  std::vector<int64_t> ids;
+  for (const auto& kv : init_window_.back().p_FinI) {
+    bool everywhere = true;
+    for (const StereoPoints& f : init_window_) everywhere = everywhere && f.p_FinI.count(kv.first) != 0;
+    if (everywhere) ids.push_back(kv.first);
+  }
+  if (static_cast<int>(ids.size()) < options_.feature_init.min_points) {
+    init_window_.pop_front();
+    return false;
+  }
+  // Their centroid in G per frame (the robot's estimates then) and its
+  // covariance from the triangulations; the velocity is the least-squares
+  // slope of the centroids over time.
+  const double n = static_cast<double>(ids.size());
+  const int64_t t_ref = init_window_.back().utime;
+  std::vector<double> t;
+  std::vector<Eigen::Vector3d> c_G;
+  Eigen::Matrix3d cov_G_mean = Eigen::Matrix3d::Zero();
+  TargetFeatureInitInfo info;
+  info.utime = utime;
+  info.feature_ids = ids;
+  for (const StereoPoints& f : init_window_) {
+    Eigen::Vector3d c_I = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d cov_I = Eigen::Matrix3d::Zero();
+    for (const int64_t id : ids) {
+      c_I += f.p_FinI.at(id);
+      cov_I += f.cov_I.at(id);
+    }
+    c_I /= n;
+    cov_I /= n * n;
+    const Eigen::Matrix3d R_ItoG = quat_to_rot(f.imu.q_GtoI).transpose();
+    t.push_back(utime_to_seconds(f.utime - t_ref));
+    c_G.push_back(f.imu.p_IinG + R_ItoG * c_I);
+    cov_G_mean += R_ItoG * cov_I * R_ItoG.transpose() / static_cast<double>(init_window_.size());
+    info.centroid_in_I = c_I;  // the last frame's
+    info.centroid_cov = cov_I;
+  }
+  double t_mean = 0.0;
+  Eigen::Vector3d c_mean = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < t.size(); ++k) {
+    t_mean += t[k] / static_cast<double>(t.size());
+    c_mean += c_G[k] / static_cast<double>(t.size());
+  }
+  double stt = 0.0;
+  Eigen::Vector3d stc = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < t.size(); ++k) {
+    stt += (t[k] - t_mean) * (t[k] - t_mean);
+    stc += (t[k] - t_mean) * (c_G[k] - c_mean);
+  }
+  if (!(stt > 0.0)) return false;
+  const Eigen::Vector3d v_G = stc / stt;
+  init_window_.clear();
+
+  // T at this frame: origin at the centroid, R_GtoT = I (so R_ItoT = R̂_GtoIᵀ
+  // and v_TinT = v_TinG), w = 0.
+  const PoseValue imu = imu_pose(state.imu()->get());
+  TargetValue local;
+  local.q_RtoT = quat_inverse(imu.q);
+  local.p_TinR = info.centroid_in_I;
+  local.v_TinT = v_G;
+  // Error of the local start: the pose is the gauge (init_sigmas.theta, p);
+  // v = the centroids' slope, whose error is the triangulation noise's slope
+  // plus the robot's velocity error (the centroids are placed in G with the
+  // robot's estimates; its pose error over the short window is dominated by
+  // δv_I · Δt, the rotation terms |v_rel| σ_θ are far below the noise); w
+  // has the broad prior, except the axes the planar model keeps at zero.
+  const TargetInitSigmas& s = options_.init_sigmas;
+  const double sw = options_.feature_init.sigma_w;
+  Matrix12d N_L = Matrix12d::Zero();
+  N_L.diagonal() << Eigen::Vector3d::Constant(s.theta * s.theta), Eigen::Vector3d::Constant(s.p * s.p),
+      Eigen::Vector3d::Zero(),
+      (options_.planar ? Eigen::Vector3d(s.w, s.w, sw) : Eigen::Vector3d::Constant(sw)).cwiseAbs2();
+  N_L.block<3, 3>(6, 6) = cov_G_mean / stt;
+  const int N = state.cov().rows();
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(12, N);  // ∂δx_T/∂δx (robot and the rest of the state)
+  B.block<3, 3>(6, state.imu()->v()->id()) = Eigen::Matrix3d::Identity();
+  Matrix12d N_T = N_L;
+  TargetValue x = local;
+  if (options_.representation == TargetRepresentation::kGlobal) {
+    // δx_G = J_T δx_L + J_I δ[θ_I p_I]: the robot's pose error enters T in G.
+    Matrix12x6d J_I;
+    Matrix12d J_T;
+    x = local_to_global(imu, local, &J_I, &J_T);
+    B = J_T * B;
+    B.middleCols(state.imu()->pose()->id(), 6) += J_I;
+    N_T = J_T * N_L * J_T.transpose();
+  }
+  const Eigen::MatrixXd P_Tx = B * state.cov();
+  Matrix12d P_TT = B * P_Tx.transpose() + N_T;
+  P_TT = 0.5 * (P_TT + P_TT.transpose()).eval();
+  add_target(state, utime, x, P_TT, P_Tx);
+  feature_init_info_ = std::move(info);
   return true;
 }
 
 void TargetFilter::update(State& state, int64_t utime, const std::vector<FeatureObservation>& obs) {
   if (!target_) {
-    if (obs.empty() || !initialize_from_truth(state, utime)) return;
+    // (A frame without target features also breaks the features start's window.)
+    const bool started = options_.init_mode == TargetInitMode::kGroundTruth
+                             ? !obs.empty() && initialize_from_truth(state, utime)
+                             : initialize_from_features(state, utime, obs);
+    if (!started) return;
   }
   if (options_.mode == TargetUpdateMode::kOff) return;
   ++frame_;

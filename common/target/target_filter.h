@@ -43,17 +43,34 @@
 // points anchor the T origin across windows, which MSCKF-only target updates
 // cannot (docs/target_model.md). Target points are target (active) variables
 // under kSkf. The MSCKF-style update above stays for the other tracks.
-// Initialisation (simulation): from the ground truth at the first frame with
-// target observations (set_ground_truth() before feed_camera), with the
-// prior init_sigmas (uncorrelated with the robot). A front-end initialiser
-// comes later.
+// Initialisation (init_mode; docs/target_model.md, "Start from the target's
+// features"):
+//   kFeatures (default, no ground truth): once feature_init.frames
+//     consecutive frames each have at least feature_init.min_points target
+//     features seen by two cameras (triangulated in I from that stereo pair
+//     alone: the target moves), the features seen in all of them give a
+//     centroid per frame, placed in G with the robot's estimate then. T is
+//     *defined* at the last frame: origin at the centroid, axes those of G
+//     (R_GtoT = I: z up, as the planar model needs), v_TinT = the centroids'
+//     least-squares slope, w = 0. T's pose relative to its points is a gauge,
+//     so its start pose gets only the small init_sigmas.{theta,p} fixing it
+//     relative to the robot; v gets the slope's noise plus the robot's
+//     velocity error, w feature_init.sigma_w (init_sigmas.w on the axes the
+//     planar model does not drive). The cross-covariance with the robot is
+//     that of this start function's Jacobian (global: composed with
+//     local_to_global's), as a delayed initialisation.
+//   kGroundTruth (simulation, the paper's convention): from the ground truth
+//     at the first frame with target observations (set_ground_truth() before
+//     feed_camera), with the prior init_sigmas (uncorrelated with the robot).
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "common/estimator/feature_database.h"
@@ -101,11 +118,36 @@ struct TargetInitSigmas {
   double w{0.01};      // rad/s
 };
 
+enum class TargetInitMode { kFeatures, kGroundTruth };
+const char* to_string(TargetInitMode mode);
+
+/// Start of the target from its own stereo features (TargetInitMode::kFeatures).
+struct TargetFeatureInit {
+  int frames{5};                    // consecutive frames the same features are triangulated in (>= 2)
+  int min_points{10};               // stereo-triangulated target features in every one of them
+  double max_point_distance{2.0};   // m from the points' median; farther ones are outliers
+  double sigma_w{0.5};              // rad/s, prior of the zero start angular velocity
+};
+
+/// What the feature initialisation did (TargetFilter::feature_init_info).
+struct TargetFeatureInitInfo {
+  int64_t utime{0};
+  std::vector<int64_t> feature_ids;  // the target features whose centroid is T's origin
+  Eigen::Vector3d centroid_in_I{Eigen::Vector3d::Zero()};
+  /// Covariance of the centroid from the stereo triangulation (pixel noise
+  /// only): how far the origin is from the true centroid of those points.
+  Eigen::Matrix3d centroid_cov{Eigen::Matrix3d::Zero()};
+};
+
 struct TargetFilterOptions {
   TargetUpdateMode mode{TargetUpdateMode::kSkf};
+  TargetInitMode init_mode{TargetInitMode::kFeatures};
+  TargetFeatureInit feature_init;
   TargetRepresentation representation{TargetRepresentation::kLocal};
   double sigma_t{0.05};   // target noise density (v: m/s²/√Hz, w: rad/s²/√Hz)
   bool planar{true};      // only v_x, v_y, w_z driven (paper Sec. IV)
+  /// kGroundTruth: the start's prior. kFeatures: theta and p fix the gauge
+  /// of the target frame (see above); v and w come from feature_init.
   TargetInitSigmas init_sigmas;
   /// The initialisation from the truth (simulation) draws its error from the
   /// init_sigmas prior with this seed, so the prior is honest; 0 = no error.
@@ -157,8 +199,11 @@ class TargetFilter : public estimator::VioExtension {
   TargetFilter(const TargetFilter&) = delete;
   TargetFilter& operator=(const TargetFilter&) = delete;
 
-  /// Ground truth for the initialisation (used if its utime is the frame's).
+  /// Ground truth for the initialisation (used if its utime is the frame's;
+  /// ignored unless init_mode is kGroundTruth).
   void set_ground_truth(const GroundTruth& truth) { truth_ = truth; }
+  /// The feature initialisation (init_mode kFeatures, once initialised).
+  const std::optional<TargetFeatureInitInfo>& feature_init_info() const { return feature_init_info_; }
 
   const TargetFilterOptions& options() const { return options_; }
   bool initialized() const { return static_cast<bool>(target_); }
@@ -189,6 +234,24 @@ class TargetFilter : public estimator::VioExtension {
 
  private:
   bool initialize_from_truth(estimator::State& state, int64_t utime);
+  // Target features seen by two cameras at utime, triangulated in I from that
+  // frame alone, with their covariances, outliers removed; nullopt if fewer
+  // than feature_init.min_points.
+  struct StereoPoints {
+    int64_t utime{0};
+    estimator::ImuValue imu;  // the robot's estimate at utime
+    std::map<int64_t, Eigen::Vector3d> p_FinI;
+    std::map<int64_t, Eigen::Matrix3d> cov_I;
+  };
+  std::optional<StereoPoints> stereo_target_points(const estimator::State& state, int64_t utime,
+                                                   const std::vector<FeatureObservation>& target_observations) const;
+  bool initialize_from_features(estimator::State& state, int64_t utime,
+                                const std::vector<FeatureObservation>& target_observations);
+  // Adds the target (the representation's value) with covariance P_TT and
+  // cross-covariance P_Tx with the current state (empty: none), and its
+  // clone at utime if the IMU has one.
+  void add_target(estimator::State& state, int64_t utime, const TargetValue& x, const Matrix12d& P_TT,
+                  const Eigen::MatrixXd& P_Tx);
   void update_tracks(estimator::State& state, std::vector<std::shared_ptr<estimator::Feature>> tracks);
   void update_points(estimator::State& state, const std::vector<FeatureObservation>& obs);
   void initialize_points(estimator::State& state, int64_t utime);
@@ -217,6 +280,8 @@ class TargetFilter : public estimator::VioExtension {
   std::optional<TargetValue> pending_;
   estimator::FeatureDatabase tracks_;
   std::optional<GroundTruth> truth_;
+  std::optional<TargetFeatureInitInfo> feature_init_info_;
+  std::deque<StereoPoints> init_window_;  // consecutive frames towards the features start
   TargetUpdateStats stats_;
   std::map<int64_t, TargetPoint> points_;
   int64_t frame_{0};

@@ -40,12 +40,18 @@ TargetRepresentation parse_target_representation(const std::string& s) {
   throw std::invalid_argument("target representation must be local or global, got '" + s + "'");
 }
 
+TargetInitMode parse_init_mode(const std::string& s) {
+  if (s == "features") return TargetInitMode::kFeatures;
+  if (s == "ground_truth") return TargetInitMode::kGroundTruth;
+  throw std::invalid_argument("target init mode must be features or ground_truth, got '" + s + "'");
+}
+
 TargetSection target_section_from_config(const Config& config) {
   TargetSection t;
   if (!config.has("target")) return t;
   const Config c = config.sub("target");
   config.check_keys("target", {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times",
-                               "init_sigmas", "points", "prediction_horizon_s"});
+                               "init", "init_sigmas", "points", "prediction_horizon_s"});
   TargetFilterOptions& o = t.filter;
   if (c.has("mode")) {
     const std::string mode = c.get<std::string>("mode");
@@ -68,6 +74,22 @@ TargetSection target_section_from_config(const Config& config) {
   o.planar = c.get_or<bool>("planar", o.planar);
   o.chi2_multiplier = positive(c, "chi2_multiplier", o.chi2_multiplier);
   o.min_clone_times = at_least(c, "min_clone_times", o.min_clone_times, 2);
+  if (c.has("init")) {
+    c.check_keys("init", {"mode", "frames", "min_points", "max_point_distance", "sigma_w"});
+    const Config i = c.sub("init");
+    if (i.has("mode")) {
+      try {
+        o.init_mode = parse_init_mode(i.get<std::string>("mode"));
+      } catch (const std::invalid_argument& e) {
+        i.fail("mode", e.what());
+      }
+    }
+    TargetFeatureInit& f = o.feature_init;
+    f.frames = at_least(i, "frames", f.frames, 2);
+    f.min_points = at_least(i, "min_points", f.min_points, 1);
+    f.max_point_distance = positive(i, "max_point_distance", f.max_point_distance);
+    f.sigma_w = positive(i, "sigma_w", f.sigma_w);
+  }
   if (c.has("init_sigmas")) {
     c.check_keys("init_sigmas", {"theta", "p", "v", "w"});
     const Config s = c.sub("init_sigmas");

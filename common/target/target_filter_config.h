@@ -7,6 +7,8 @@
 //                                     runs pure VIO; the evaluator refuses it)
 //     representation: local | global
 //     sigma_t, planar, chi2_multiplier, min_clone_times,
+//     init: {mode: features | ground_truth, frames, min_points,
+//            max_point_distance, sigma_w}   (docs/target_model.md),
 //     init_sigmas: {theta, p, v, w},
 //     points: {max, init_clone_times, max_lost_frames},
 //     prediction_horizon_s   (the process's TARGET_PREDICTION horizon)
@@ -34,6 +36,8 @@ TargetSection target_section_from_config(const Config& config);
 TargetUpdateMode parse_target_mode(const std::string& s);
 /// "local" | "global"; throws std::invalid_argument otherwise.
 TargetRepresentation parse_target_representation(const std::string& s);
+/// "features" | "ground_truth"; throws std::invalid_argument otherwise.
+TargetInitMode parse_init_mode(const std::string& s);
 
 }  // namespace target
 }  // namespace vimot

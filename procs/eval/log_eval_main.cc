@@ -37,6 +37,10 @@ int run(int argc, const char* const* argv) {
   args.add_option("state-channel", "CHANNEL", "nav_state_t channel", "VINS_STATE");
   args.add_option("truth-channel", "CHANNEL", "ground_truth_t channel", "GROUND_TRUTH");
   args.add_option("target-channel", "CHANNEL", "target_state_t channel to evaluate too (e.g. TARGET_STATE)");
+  args.add_flag("own-target-frame",
+                "with --target-channel: the filter started its target from its features (target.init.mode\n"
+                "features), so its target frame is its own: compare through the fixed transform to the true\n"
+                "frame taken at its first target state (printed)");
   args.add_option("compare-target", "SUMMARY_JSON",
                   "with --target-channel: print the relative difference of the target figures to a\n"
                   "one-run vimot-target-eval summary.json (its first target-filter cell)");
@@ -60,6 +64,7 @@ int run(int argc, const char* const* argv) {
   opt.state_channel = args.get("state-channel");
   opt.truth_channel = args.get("truth-channel");
   opt.target_channel = args.get("target-channel");
+  opt.target_own_frame = args.given("own-target-frame");
   if (args.given("scale-truth")) {
     opt.scale_channel = args.get("scale-channel");
     opt.metric_channel = args.get("metric-channel");
@@ -115,6 +120,10 @@ int run(int argc, const char* const* argv) {
                 static_cast<long long>(tc.duplicate_states), static_cast<long long>(r.malformed_targets),
                 static_cast<long long>(tc.matched), static_cast<long long>(tc.unmatched),
                 static_cast<long long>(tc.bad_covariance));
+    if (opt.target_own_frame) {
+      std::printf("target frame (filter's in the true one, fixed at its first state): %s\n",
+                  r.target_samples.target_frame.describe().c_str());
+    }
     for (const auto& [name, ts] : {std::pair<const char*, const eval::ErrorSummary&>{"in IMU  ", r.target_in_imu},
                                    std::pair<const char*, const eval::ErrorSummary&>{"in world", r.target_in_world}}) {
       // TARGET_STATE carries the covariance of its representation only

@@ -1,6 +1,7 @@
 // target_filter: the joint robot + moving-target filter (Schmidt-EKF paper)
 // as an LCM process. Subscribes IMU, FEATURES (static + target
-// observations) and GROUND_TRUTH (initialisation in simulation); publishes
+// observations) and GROUND_TRUTH (the robot's start in simulation; the
+// target's only with target.init.mode ground_truth); publishes
 // per processed frame NAV_STATE (nav_state_t, updated = true),
 // TARGET_STATE (target_state_t) and TARGET_PREDICTION (target_prediction_t).
 // All logic is in TargetFilterNode / the target library; this file moves bytes.
@@ -45,7 +46,7 @@ int run(int argc, const char* const* argv) {
   callbacks.on_event = vimot::report_events_to(process);
   vimot::TargetFilterNode node(options, callbacks);
   if (!options.target_enabled) vimot::log_info("target.mode none: VIO only, no target outputs");
-  // Ground truth is always subscribed: it also initialises the target (simulation).
+  // Ground truth is always subscribed: the robot's start (simulation), and the target's in init.mode ground_truth.
   const int status = vimot::run_estimator_node(process, node, /*use_ground_truth=*/true, max_wait);
   vimot::log_info("target ", node.target_initialized() ? "initialised" : "not initialised");
   return status;

@@ -87,7 +87,7 @@ TargetFilterNode::TargetFilterNode(const TargetFilterNodeOptions& options, Callb
             if (callbacks_.on_event) callbacks_.on_event(e);
           }) {
   if (options_.target_enabled) {
-    // The target starts from the truth with the robot's perturbation seed, as in vimot-target-eval.
+    // A start from the truth is perturbed with the robot's seed, as in vimot-target-eval.
     target::TargetFilterOptions target = options_.target;
     target.init_perturb_seed = options_.perturb_seed;
     filter_ = std::make_unique<target::TargetFilter>(vins_.mutable_estimator(), target);
@@ -104,7 +104,7 @@ void TargetFilterNode::on_frame(const CameraFrame& frame) { vins_.on_frame(frame
 void TargetFilterNode::flush() { vins_.flush(); }
 
 void TargetFilterNode::on_ground_truth(const GroundTruth& truth) {
-  if (filter_ && truth.has_target) {
+  if (filter_ && truth.has_target && options_.target.init_mode == target::TargetInitMode::kGroundTruth) {
     truths_[truth.utime] = truth;
     const int64_t keep_from = truth.utime - static_cast<int64_t>(options_.ground_truth_buffer_s * 1e6);
     while (!truths_.empty() && truths_.begin()->first < keep_from) truths_.erase(truths_.begin());
@@ -114,7 +114,7 @@ void TargetFilterNode::on_ground_truth(const GroundTruth& truth) {
 
 void TargetFilterNode::before_frame(const CameraFrame& frame) {
   if (!filter_ || filter_->initialized()) return;
-  // The filter initialises the target from the truth at the frame's utime.
+  // init.mode ground_truth: the target starts from the truth at the frame's utime (features: nothing buffered).
   const auto it = truths_.find(frame.utime);
   if (it != truths_.end()) filter_->set_ground_truth(it->second);
 }

@@ -11,9 +11,10 @@
 //   * once the target is initialised: the target state (TARGET_STATE) and its
 //     prediction prediction_horizon_s ahead (TARGET_PREDICTION) — also for
 //     frames without target observations (the target is then only predicted).
-// Initialisation (simulation): the robot from the first GROUND_TRUTH message
-// (as vins), the target from the ground truth at the utime of the first frame
-// with target observations (ground truth is buffered by utime for that).
+// Initialisation: the robot as vins does; the target from its own features
+// (target.init.mode features, no ground truth) or, in simulation, from the
+// ground truth at the utime of the first frame with target observations
+// (init.mode ground_truth: ground truth is buffered by utime for that).
 
 #include <cstdint>
 #include <functional>

@@ -129,4 +129,11 @@ TEST_CASE("target config: keys and errors", "[eval][target]") {
   CHECK_THROWS_WITH(bad("target: {sigma_t: -1}"), Catch::Contains("target.sigma_t"));
   CHECK_THROWS_WITH(bad("target: {sigmat: 1}"), Catch::Contains("target.sigmat"));
   CHECK_THROWS_WITH(bad("target: {points: {max: -1}}"), Catch::Contains("target.points.max"));
+  // The shipped config starts the target from its features (no ground truth).
+  CHECK(f.init_mode == target::TargetInitMode::kFeatures);
+  CHECK(bad("target: {init: {mode: ground_truth}}").init_mode == target::TargetInitMode::kGroundTruth);
+  CHECK(bad("target: {init: {frames: 3, min_points: 6}}").feature_init.frames == 3);
+  CHECK_THROWS_WITH(bad("target: {init: {mode: truth}}"), Catch::Contains("target.init.mode"));
+  CHECK_THROWS_WITH(bad("target: {init: {frames: 1}}"), Catch::Contains("target.init.frames"));
+  CHECK_THROWS_WITH(bad("target: {init: {sigma_v: 1}}"), Catch::Contains("target.init.sigma_v"));
 }

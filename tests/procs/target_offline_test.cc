@@ -3,7 +3,8 @@
 // whose errors against the truth, matched as vimot-log-eval matches
 // a recorded run (eval::TruthMatcher), are exactly those of the offline
 // evaluator (eval::run_target_on_sim, vimot-target-eval) on the same
-// scenario, options and perturbation.
+// scenario, options and perturbation, for both target starts (init.mode
+// features through the fixed target-frame transform, and ground_truth).
 #include <catch2/catch.hpp>
 
 #include <variant>
@@ -36,32 +37,42 @@ TEST_CASE("target filter node publishes exactly the offline evaluator's estimate
   cfg.seed = 5;
   cfg.duration = 10.0;
   cfg.ground_truth_events = true;
-  TargetFilterNodeOptions options = node_options_from_config(Config::load_file(source_path("config/target_filter.yaml")));
-  options.perturb_seed = 9;
-  REQUIRE(options.init_from_ground_truth);
-  const eval::TargetRunResult offline =
-      eval::run_target_on_sim(cfg, options.vio, options.target, options.perturb_seed, {}, /*keep_samples=*/true);
-  REQUIRE(offline.target_initialized);
-  REQUIRE(offline.target_in_world_samples.size() >= 50);
+  const TargetFilterNodeOptions shipped =
+      node_options_from_config(Config::load_file(source_path("config/target_filter.yaml")));
+  REQUIRE(shipped.target.init_mode == target::TargetInitMode::kFeatures);
+  // Both target starts: the shipped one from the filter's own features (its
+  // own target frame, matched through the fixed transform) and from the truth.
+  for (const auto init : {target::TargetInitMode::kFeatures, target::TargetInitMode::kGroundTruth}) {
+    INFO("target start " << target::to_string(init));
+    TargetFilterNodeOptions options = shipped;
+    options.target.init_mode = init;
+    options.perturb_seed = 9;
+    REQUIRE(options.init_from_ground_truth);
+    const eval::TargetRunResult offline =
+        eval::run_target_on_sim(cfg, options.vio, options.target, options.perturb_seed, {}, /*keep_samples=*/true);
+    REQUIRE(offline.target_initialized);
+    REQUIRE(offline.target_in_world_samples.size() >= 50);
 
-  eval::TruthMatcher matcher;
-  TargetFilterNode::Callbacks cb;
-  cb.on_target_state = [&](const TargetStateEstimate& s) { matcher.add_target(s); };
-  TargetFilterNode node(options, cb);
-  sim::Simulator(cfg).run([&](const sim::SimEvent& e) {
-    if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
-    if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
-    if (const auto* gt = std::get_if<GroundTruth>(&e)) {
-      node.on_ground_truth(*gt);
-      matcher.add_truth(*gt);
-    }
-  });
-  node.flush();
+    eval::TruthMatcher matcher;
+    TargetFilterNode::Callbacks cb;
+    cb.on_target_state = [&](const TargetStateEstimate& s) { matcher.add_target(s); };
+    TargetFilterNode node(options, cb);
+    sim::Simulator(cfg).run([&](const sim::SimEvent& e) {
+      if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
+      if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
+      if (const auto* gt = std::get_if<GroundTruth>(&e)) {
+        node.on_ground_truth(*gt);
+        matcher.add_truth(*gt);
+      }
+    });
+    node.flush();
 
-  eval::TargetMatchCounts counts;
-  const eval::TargetMatch lcm = matcher.match_targets(&counts);
-  REQUIRE(lcm.target_in_world.size() == offline.target_in_world_samples.size());
-  REQUIRE(lcm.target_in_imu.size() == offline.target_in_imu_samples.size());
-  CHECK(differing(lcm.target_in_world, offline.target_in_world_samples) == 0);
-  CHECK(differing(lcm.target_in_imu, offline.target_in_imu_samples) == 0);
+    eval::TargetMatchCounts counts;
+    const bool own_frame = init == target::TargetInitMode::kFeatures;
+    const eval::TargetMatch lcm = matcher.match_targets(&counts, own_frame);
+    REQUIRE(lcm.target_in_world.size() == offline.target_in_world_samples.size());
+    REQUIRE(lcm.target_in_imu.size() == offline.target_in_imu_samples.size());
+    CHECK(differing(lcm.target_in_world, offline.target_in_world_samples) == 0);
+    CHECK(differing(lcm.target_in_imu, offline.target_in_imu_samples) == 0);
+  }
 }

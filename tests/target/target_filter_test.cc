@@ -162,6 +162,7 @@ TargetFilterOptions filter_options(TargetUpdateMode mode, TargetRepresentation r
   o.representation = rep;
   o.sigma_t = sigma_t;
   o.planar = true;
+  o.init_mode = TargetInitMode::kGroundTruth;  // the paper's convention: these runs feed the truth
   return o;
 }
 
