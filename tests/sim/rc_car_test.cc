@@ -19,14 +19,6 @@ namespace {
 
 SimConfig rc_car_config() { return test::load_config("config/sim_paper_rc_car.yaml"); }
 
-// cam0 pose in G from the IMU pose and the calibration.
-void cam0_in_G(const Simulator& sim, double t, Eigen::Matrix3d* R_CtoG, Eigen::Vector3d* p_CinG) {
-  const SplineState I = sim.robot_state(t);
-  const CameraCalibration& calib = sim.cameras().at(0);
-  *R_CtoG = I.R_BtoG * calib.R_ItoC.transpose();
-  *p_CinG = I.p_BinG - *R_CtoG * calib.p_IinC;
-}
-
 }  // namespace
 
 TEST_CASE("RcCarCourse: a seeded course of the semicircle's length and turn, with stops", "[sim][rc_car]") {
@@ -146,7 +138,7 @@ TEST_CASE("Paper scenario, rc_car target: exact spline derivatives, planar, spee
     // The UAV keeps the target within its standoff and on its optical axis.
     Eigen::Matrix3d R_CtoG;
     Eigen::Vector3d p_C;
-    cam0_in_G(sim, t, &R_CtoG, &p_C);
+    test::cam0_in_G(sim, t, &R_CtoG, &p_C);
     const Eigen::Vector3d to_target = T.p_BinG - p_C;
     max_distance_seen = std::max(max_distance_seen, to_target.norm());
     max_cam_angle = std::max(max_cam_angle, std::acos(std::min(1.0, R_CtoG.col(2).dot(to_target.normalized()))));
