@@ -29,26 +29,24 @@ double smoothstep_integral(double x) { return x * x * x * x * (2.5 + x * (-3.0 +
 
 RcCarCourse::RcCarCourse(const RcCarConfig& c, double radius, double start_angle, double height, uint64_t seed)
     : length_(M_PI * radius),
-      spacing_(c.curvature_spacing),
+      spacing_(length_ / std::max(1.0, std::round(length_ / c.heading_spacing))),
       heading0_(start_angle + 0.5 * M_PI),
       start_(radius * std::cos(start_angle), radius * std::sin(start_angle), height) {
   if (!(radius > 0.0) || !(c.speed_min > 0.0) || !(c.speed_max >= c.speed_min) || !(c.max_acceleration > 0.0) ||
       !(c.hold_min > 0.0) || !(c.hold_max >= c.hold_min) || !(c.stop_min >= 0.0) || !(c.stop_max >= c.stop_min) ||
-      !(c.stop_probability >= 0.0 && c.stop_probability < 1.0) || !(c.curvature_spacing > 0.0)) {
+      !(c.stop_probability >= 0.0 && c.stop_probability < 1.0) || !(c.heading_spacing > 0.0)) {
     throw std::invalid_argument("RcCarCourse: invalid paper.rc_car config (see validate())");
   }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   auto draw = [&](double lo, double hi) { return lo + (hi - lo) * uniform(rng); };
 
-  // Curvature knots over [0, L], then the shift that makes the total turn π.
-  const double mean_curvature = 1.0 / radius;
-  const int n_knots = static_cast<int>(std::ceil(length_ / spacing_)) + 2;
-  for (int k = 0; k < n_knots; ++k) {
-    knots_.push_back(mean_curvature * (1.0 + c.curvature_variation * draw(-1.0, 1.0)));
-  }
-  const double shift = (M_PI - curvature_integral(length_)) / length_;
-  for (double& kappa : knots_) kappa += shift;
+  // Heading deviation knots over [0, L], zero at both ends.
+  mean_curvature_ = 1.0 / radius;
+  const auto n_intervals = static_cast<int>(std::lround(length_ / spacing_));
+  knots_.assign(1, 0.0);
+  for (int k = 1; k < n_intervals; ++k) knots_.push_back(draw(-c.heading_deviation, c.heading_deviation));
+  knots_.push_back(0.0);
 
   // Speed legs until the course is driven, then kRunOut s more.
   double t = 0.0, s = 0.0, v = 0.0;
@@ -106,19 +104,16 @@ double RcCarCourse::speed(double t) const {
   return seg.v0 + (seg.v1 - seg.v0) * smoothstep(x);
 }
 
-double RcCarCourse::curvature_integral(double s) const {
-  // Whole knot intervals, then the part of the last one; constant past the last knot.
-  const int last = static_cast<int>(knots_.size()) - 1;
-  const int k = std::min(static_cast<int>(std::floor(s / spacing_)), last);
-  double sum = 0.0;
-  for (int j = 0; j < k && j < last; ++j) sum += spacing_ * (knots_[j] + 0.5 * (knots_[j + 1] - knots_[j]));
-  const double rest = s - k * spacing_;
-  if (k >= last) return sum + knots_[last] * rest;
-  const double x = rest / spacing_;
-  return sum + spacing_ * (knots_[k] * x + (knots_[k + 1] - knots_[k]) * smoothstep_integral(x));
+double RcCarCourse::heading_deviation(double s) const {
+  const auto k = static_cast<std::size_t>(std::floor(s / spacing_));
+  if (k + 1 >= knots_.size()) return 0.0;  // past the course: the circle goes on
+  return knots_[k] + (knots_[k + 1] - knots_[k]) * smoothstep(s / spacing_ - static_cast<double>(k));
 }
 
-double RcCarCourse::heading(double s) const { return heading0_ + curvature_integral(std::max(s, 0.0)); }
+double RcCarCourse::heading(double s) const {
+  s = std::max(s, 0.0);
+  return heading0_ + mean_curvature_ * s + heading_deviation(s);
+}
 
 Eigen::Vector2d RcCarCourse::position(double s) const {
   s = std::max(s, 0.0);

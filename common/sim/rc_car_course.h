@@ -4,12 +4,14 @@
 // do (RcCarConfig, docs/simulator.md).
 //
 // Geometry and timing are drawn separately, both from one seed:
-//  * the path, as a function of arc length s: curvature knots every
-//    `curvature_spacing` m at κ̄ (1 + variation u), κ̄ = 1/radius, joined by
-//    the quintic smoothstep S(σ) = 10σ³ - 15σ⁴ + 6σ⁵ (C²), shifted so that
-//    the heading turns by exactly π over the length L = π radius;
-//    heading ψ(s) = ψ0 + ∫κ ds in closed form, position ∫[cos ψ, sin ψ] ds
-//    by 3-point Gauss-Legendre on a 5 cm grid (error < 1e-12 m);
+//  * the path, as a function of arc length s: the semicircle's heading plus
+//    a deviation, ψ(s) = ψ0 + s/radius + δ(s), δ drawn at n + 1 knots
+//    spaced L/n ≈ heading_spacing over the length L = π radius, uniform in
+//    ±heading_deviation, 0 at both ends (so the course turns by exactly π
+//    and stays near the semicircle), joined by the quintic smoothstep
+//    S(σ) = 10σ³ - 15σ⁴ + 6σ⁵; curvature 1/radius + δ'(s), S-bends where δ
+//    swings; past L, δ = 0. Position ∫[cos ψ, sin ψ] ds by 3-point
+//    Gauss-Legendre on a 5 cm grid (error < 1e-12 m);
 //  * the distance driven s(t): legs of constant speed (a cruising speed in
 //    [speed_min, speed_max] or a stop) joined by smoothstep speed changes
 //    whose peak acceleration is max_acceleration (S' peaks at 15/8), s(t) in
@@ -53,14 +55,15 @@ class RcCarCourse {
     double s0{0.0};                 // distance driven at t0 (m)
   };
   const SpeedSegment& segment_at(double t) const;
-  double curvature_integral(double s) const;  // ∫_0^s κ
+  double heading_deviation(double s) const;  // δ(s)
   Eigen::Vector2d position(double s) const;   // relative to the start
   Eigen::Vector2d tangent_integral(double a, double b) const;  // ∫_a^b [cos ψ, sin ψ] ds
 
   double length_{0.0};
   double duration_{0.0};
   double spacing_{0.0};
-  std::vector<double> knots_;  // κ at s = k spacing
+  double mean_curvature_{0.0};  // 1 / radius
+  std::vector<double> knots_;   // δ at s = k spacing_
   double heading0_{0.0};
   Eigen::Vector3d start_{Eigen::Vector3d::Zero()};
   std::vector<SpeedSegment> segments_;

@@ -42,10 +42,10 @@ std::string rc_car_problem(const RcCarConfig& rc) {
     err << "key 'paper.rc_car.max_acceleration' must be > 0, got " << fmt(rc.max_acceleration);
   } else if (!(rc.stop_probability >= 0.0 && rc.stop_probability < 1.0)) {
     err << "key 'paper.rc_car.stop_probability' must be in [0, 1), got " << fmt(rc.stop_probability);
-  } else if (!(rc.curvature_spacing > 0.0) || !std::isfinite(rc.curvature_spacing)) {
-    err << "key 'paper.rc_car.curvature_spacing' must be > 0, got " << fmt(rc.curvature_spacing);
-  } else if (!(rc.curvature_variation >= 0.0) || !std::isfinite(rc.curvature_variation)) {
-    err << "key 'paper.rc_car.curvature_variation' must be >= 0, got " << fmt(rc.curvature_variation);
+  } else if (!(rc.heading_spacing > 0.0) || !std::isfinite(rc.heading_spacing)) {
+    err << "key 'paper.rc_car.heading_spacing' must be > 0, got " << fmt(rc.heading_spacing);
+  } else if (!(rc.heading_deviation >= 0.0 && rc.heading_deviation < 0.5 * M_PI)) {
+    err << "key 'paper.rc_car.heading_deviation' must be in [0, π/2), got " << fmt(rc.heading_deviation);
   }
   return err.str();
 }
@@ -228,7 +228,7 @@ void read_target_motion(const Config& config, const Reader& r, PaperScenarioConf
     r.fail("paper.target_motion", std::string("is invalid: ") + e.what());
   }
   r.only_keys("paper.rc_car", {"speed_range", "max_acceleration", "hold_range", "stop_probability", "stop_range",
-                               "curvature_spacing", "curvature_variation"});
+                               "heading_spacing", "heading_deviation"});
   RcCarConfig& rc = paper->rc_car;
   auto read_range = [&](const std::string& key, double* lo, double* hi) {
     if (!config.has(key)) return;
@@ -241,8 +241,8 @@ void read_target_motion(const Config& config, const Reader& r, PaperScenarioConf
   read_range("paper.rc_car.hold_range", &rc.hold_min, &rc.hold_max);
   r.read("paper.rc_car.stop_probability", &rc.stop_probability);
   read_range("paper.rc_car.stop_range", &rc.stop_min, &rc.stop_max);
-  r.read("paper.rc_car.curvature_spacing", &rc.curvature_spacing);
-  r.read("paper.rc_car.curvature_variation", &rc.curvature_variation);
+  r.read("paper.rc_car.heading_spacing", &rc.heading_spacing);
+  r.read("paper.rc_car.heading_deviation", &rc.heading_deviation);
 }
 
 }  // namespace

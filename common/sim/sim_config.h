@@ -111,10 +111,11 @@ struct RcCarConfig {
   double stop_probability{0.15};  // per speed change: stop instead
   double stop_min{1.0};           // s, standstill duration
   double stop_max{3.0};           // s
-  double curvature_spacing{15.0}; // m, arc length between curvature knots
-  /// Knot curvatures κ̄ (1 + variation u), u ~ U[-1, 1], κ̄ = 1 / radius,
-  /// then shifted so the course turns by π in all; > 1 gives S-bends.
-  double curvature_variation{1.5};
+  /// The heading is the semicircle's plus a deviation δ(s), drawn at knots
+  /// every ~heading_spacing m of arc, δ ~ U[-heading_deviation,
+  /// heading_deviation], 0 at both ends (so the course turns by π).
+  double heading_spacing{20.0};   // m
+  double heading_deviation{0.25}; // rad
 };
 
 struct PaperScenarioConfig {

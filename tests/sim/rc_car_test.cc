@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Geometry>
+
 #include "common/sim/rc_car_course.h"
 #include "common/sim/simulator.h"
 #include "tests/sim/sim_test_util.h"
@@ -91,6 +93,8 @@ TEST_CASE("Paper scenario, rc_car target: exact spline derivatives, planar, spee
                                               c.paper.height + amp.z() - h_T)
                                   .norm();
   double v_min = 1e9, v_max = 0.0, v_sum = 0.0, a_tan_max = 0.0, a_lat_max = 0.0, w_min = 1e9, w_max = -1e9;
+  double k_min = 1e9, k_max = -1e9;  // curvature ω_z / speed while moving
+  Eigen::AlignedBox2d extent;
   double stopped = 0.0, max_slip = 0.0, max_cam_angle = 0.0, max_distance_seen = 0.0, imu_w_max = 0.0,
          imu_a_max = 0.0;
   int n = 0;
@@ -120,6 +124,7 @@ TEST_CASE("Paper scenario, rc_car target: exact spline derivatives, planar, spee
     CHECK(std::abs(T.v_BinG.z()) < 1e-9);
     CHECK(T.w_BinB.head<2>().norm() < 1e-9);
 
+    extent.extend(Eigen::Vector2d(T.p_BinG.head<2>()));
     const Eigen::Vector3d v_T = T.R_BtoG.transpose() * T.v_BinG;  // body velocity
     const double speed = T.v_BinG.norm();
     if (speed < 1e-9) stopped += step;
@@ -132,6 +137,10 @@ TEST_CASE("Paper scenario, rc_car target: exact spline derivatives, planar, spee
     const Eigen::Vector3d a_T = T.R_BtoG.transpose() * T.a_BinG;
     a_tan_max = std::max(a_tan_max, std::abs(a_T.x()));
     a_lat_max = std::max(a_lat_max, std::abs(a_T.y()));
+    if (speed > 0.3) {
+      k_min = std::min(k_min, T.w_BinB.z() / speed);
+      k_max = std::max(k_max, T.w_BinB.z() / speed);
+    }
     w_min = std::min(w_min, T.w_BinB.z());
     w_max = std::max(w_max, T.w_BinB.z());
 
@@ -147,12 +156,14 @@ TEST_CASE("Paper scenario, rc_car target: exact spline derivatives, planar, spee
     imu_a_max = std::max(imu_a_max, I.a_BinG.norm());
   }
   std::printf(
-      "rc_car (map_seed %d): %.2f s, %.1f m; target speed %.3f-%.3f m/s (mean %.3f), stopped %.1f s; "
-      "|a| tangential <= %.3f, lateral <= %.3f m/s^2; turn rate %.4f..%.4f rad/s; side slip <= %.2e of the speed; "
+      "rc_car (map_seed %d): %.2f s, %.1f m, x %.1f..%.1f y %.1f..%.1f m, end (%.1f, %.1f); target speed %.3f-%.3f m/s (mean %.3f), stopped %.1f s; "
+      "|a| tangential <= %.3f, lateral <= %.3f m/s^2; turn rate %.4f..%.4f rad/s; curvature %.4f..%.4f 1/m; side slip <= %.2e of the speed; "
       "UAV: camera-target distance <= %.2f m (bound %.2f), optical axis off the target <= %.4f deg, "
       "IMU |w| <= %.3f rad/s, |a| <= %.3f m/s^2\n",
-      static_cast<int>(c.map_seed), sim.duration(), course.length(), v_min, v_max, v_sum / n, stopped, a_tan_max,
-      a_lat_max, w_min, w_max, max_slip, max_distance_seen, max_distance, max_cam_angle * 180.0 / M_PI, imu_w_max,
+      static_cast<int>(c.map_seed), sim.duration(), course.length(), extent.min().x(), extent.max().x(),
+      extent.min().y(), extent.max().y(), sim.target_state(sim.duration())->p_BinG.x(),
+      sim.target_state(sim.duration())->p_BinG.y(), v_min, v_max, v_sum / n, stopped, a_tan_max,
+      a_lat_max, w_min, w_max, k_min, k_max, max_slip, max_distance_seen, max_distance, max_cam_angle * 180.0 / M_PI, imu_w_max,
       imu_a_max);
   // The spline stays within the course's speed range (it averages control
   // poses) and reproduces its stops exactly (equal control poses).
