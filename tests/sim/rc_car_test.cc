@@ -208,5 +208,8 @@ TEST_CASE("paper.target_motion and paper.rc_car: read, and bad values named", "[
   bad = c;
   bad.paper.rc_car.max_acceleration = std::nan("");
   CHECK_THROWS_WITH(validate(bad), Catch::Contains("paper.rc_car.max_acceleration"));
+  bad = c;
+  bad.paper.rc_car.heading_deviation = 2.0;
+  CHECK_THROWS_WITH(validate(bad), Catch::Contains("paper.rc_car.heading_deviation"));
   CHECK_THROWS_WITH(target_motion_from_string("bicycle"), Catch::Contains("semicircle or rc_car"));
 }
