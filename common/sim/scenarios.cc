@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/math/quat.h"
+#include "common/sim/rc_car_course.h"
 #include "common/sim/trajectory_file.h"
 
 namespace vimot {
@@ -18,6 +19,9 @@ constexpr double kTwoPi = 2.0 * M_PI;
 constexpr double kMinFileSplineDt = 0.05;
 // Spacing (s) at which spline positions are sampled for workspace bounds.
 constexpr double kBoundsSampleDt = 0.5;
+// Random stream of the rc_car course, from map_seed (derive_seed; the
+// simulator's other streams are 10-13).
+constexpr uint64_t kStreamCourse = 14;
 
 std::string fmt(double v) {
   std::ostringstream ss;
@@ -50,29 +54,42 @@ double target_center_height(const TargetConfig& target) { return target.base_hei
 ScenarioMotion make_paper(const SimConfig& config) {
   const PaperScenarioConfig& pc = config.paper;
   const CameraCalibration& cam0 = config.camera.calibrations.at(0);
-  // Splines and workspace cover at least the whole semicircle, so a shorter
-  // run is an exact prefix of the full one (same map, same events).
-  const double natural = M_PI * pc.radius / pc.speed;
+  const double h_T = target_center_height(config.target);
+  std::optional<RcCarCourse> course;
+  if (pc.target_motion == TargetMotion::kRcCar) {
+    course.emplace(pc.rc_car, pc.radius, pc.target_start_angle, h_T, derive_seed(config.map_seed, kStreamCourse));
+  }
+  // Splines and workspace cover at least the whole course, so a shorter run
+  // is an exact prefix of the full one (same map, same events).
+  const double natural = course ? course->duration() : M_PI * pc.radius / pc.speed;
   const double duration = config.duration > 0.0 ? config.duration : natural;
   const double span = std::max(duration, natural);
-  const double h_T = target_center_height(config.target);
 
-  // Polar angle of the target on its circle at time t (counter-clockwise).
+  // Polar angle of the semicircle's target at time t (counter-clockwise).
   auto angle = [&pc](double t) { return pc.target_start_angle + pc.speed * t / pc.radius; };
   auto target_position = [&pc, &angle, h_T](double t) {
     const double th = angle(t);
     return Eigen::Vector3d(pc.radius * std::cos(th), pc.radius * std::sin(th), h_T);
   };
   auto target_pose = [&](double t) {
+    if (course) return course->pose(t);
     // Heading along the tangent: yaw = θ + π/2, T's x axis forward.
     return make_se3(rot_z(angle(t) + 0.5 * M_PI), target_position(t));
   };
-  auto robot_pose = [&](double t) {
+  // Unit path tangent (the target's heading) at time t.
+  auto tangent_at = [&](double t) {
+    if (course) {
+      const double yaw = course->heading(course->distance(t));
+      return Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);
+    }
     const double th = angle(t);
-    const Eigen::Vector3d tangent(-std::sin(th), std::cos(th), 0.0);
+    return Eigen::Vector3d(-std::sin(th), std::cos(th), 0.0);
+  };
+  auto robot_pose = [&](double t) {
+    const Eigen::Vector3d tangent = tangent_at(t);
     const Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(tangent);
     const Eigen::Vector3d osc = eval_sinusoids({pc.oscillation}, t);
-    const Eigen::Vector3d p_T = target_position(t);
+    const Eigen::Vector3d p_T = target_pose(t).topRightCorner<3, 1>();
     Eigen::Vector3d p_C = p_T + (osc.x() - pc.standoff) * tangent + (pc.lateral_offset + osc.y()) * left;
     p_C.z() = pc.height + osc.z();
     return body_pose_from_camera(look_at_R_CtoG(p_C, p_T), p_C, cam0);

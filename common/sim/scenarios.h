@@ -6,7 +6,9 @@
 //  * paper: the target (box centre T) drives a counter-clockwise semicircle
 //    of radius r at constant speed on the plane z = base_height + size_z/2,
 //    heading along the path (planar: yaw-only rotation, velocity in its x-y
-//    plane). The UAV camera stays `standoff` behind it along the path
+//    plane); with paper.target_motion rc_car it drives RcCarCourse instead
+//    (same start, length and plane; speed and curvature varying, stops),
+//    drawn from map_seed. The UAV camera stays `standoff` behind it along the path
 //    tangent, `lateral_offset` to the left, at `height` above the floor, plus
 //    the oscillation; its optical axis points at the target centre with the
 //    camera x axis horizontal, and R_ItoG = R_CtoG R_ItoC (cam0).

@@ -66,6 +66,32 @@ std::string render_problem(const SimConfig& c) {
   return err.str();
 }
 
+// paper.rc_car (issue 15): "" or its first problem.
+std::string rc_car_problem(const RcCarConfig& rc) {
+  std::ostringstream err;
+  auto range = [&err](const char* key, double lo, double hi, bool zero_ok) {
+    const bool ok = std::isfinite(lo) && std::isfinite(hi) && (zero_ok ? lo >= 0.0 : lo > 0.0) && hi >= lo;
+    if (!ok && err.tellp() == 0) {
+      err << "key 'paper.rc_car." << key << "' must be [min, max] with " << (zero_ok ? "0 <= " : "0 < ")
+          << "min <= max, got [" << fmt(lo) << ", " << fmt(hi) << "]";
+    }
+  };
+  range("speed_range", rc.speed_min, rc.speed_max, false);
+  range("hold_range", rc.hold_min, rc.hold_max, false);
+  range("stop_range", rc.stop_min, rc.stop_max, true);
+  if (err.tellp() != 0) return err.str();
+  if (!(rc.max_acceleration > 0.0) || !std::isfinite(rc.max_acceleration)) {
+    err << "key 'paper.rc_car.max_acceleration' must be > 0, got " << fmt(rc.max_acceleration);
+  } else if (!(rc.stop_probability >= 0.0 && rc.stop_probability < 1.0)) {
+    err << "key 'paper.rc_car.stop_probability' must be in [0, 1), got " << fmt(rc.stop_probability);
+  } else if (!(rc.heading_spacing > 0.0) || !std::isfinite(rc.heading_spacing)) {
+    err << "key 'paper.rc_car.heading_spacing' must be > 0, got " << fmt(rc.heading_spacing);
+  } else if (!(rc.heading_deviation >= 0.0 && rc.heading_deviation < 0.5 * M_PI)) {
+    err << "key 'paper.rc_car.heading_deviation' must be in [0, π/2), got " << fmt(rc.heading_deviation);
+  }
+  return err.str();
+}
+
 // Returns "" or the first problem as "key 'a.b' must ..., got ...".
 std::string problem(const SimConfig& c) {
   std::ostringstream err;
@@ -139,6 +165,7 @@ std::string problem(const SimConfig& c) {
               << fmt(c.paper.standoff) << " / " << fmt(c.paper.lateral_offset);
         }
       }
+      if (err.tellp() == 0 && c.paper.target_motion == TargetMotion::kRcCar) err << rc_car_problem(c.paper.rc_car);
       break;
     case Scenario::kTrajectory:
       if (c.trajectory.file.empty()) err << "key 'trajectory.file' must name a trajectory file";
@@ -227,6 +254,33 @@ std::string expand_env(const Reader& r, const std::string& key, const std::strin
   return out;
 }
 
+// paper.target_motion and paper.rc_car (issue 15).
+void read_target_motion(const Config& config, const Reader& r, PaperScenarioConfig* paper) {
+  try {
+    if (config.has("paper.target_motion")) {
+      paper->target_motion = target_motion_from_string(config.get<std::string>("paper.target_motion"));
+    }
+  } catch (const std::invalid_argument& e) {
+    r.fail("paper.target_motion", std::string("is invalid: ") + e.what());
+  }
+  r.only_keys("paper.rc_car", {"speed_range", "max_acceleration", "hold_range", "stop_probability", "stop_range",
+                               "heading_spacing", "heading_deviation"});
+  RcCarConfig& rc = paper->rc_car;
+  auto read_range = [&](const std::string& key, double* lo, double* hi) {
+    if (!config.has(key)) return;
+    const Eigen::Vector2d v = config.get_vec<2>(key);
+    *lo = v.x();
+    *hi = v.y();
+  };
+  read_range("paper.rc_car.speed_range", &rc.speed_min, &rc.speed_max);
+  r.read("paper.rc_car.max_acceleration", &rc.max_acceleration);
+  read_range("paper.rc_car.hold_range", &rc.hold_min, &rc.hold_max);
+  r.read("paper.rc_car.stop_probability", &rc.stop_probability);
+  read_range("paper.rc_car.stop_range", &rc.stop_min, &rc.stop_max);
+  r.read("paper.rc_car.heading_spacing", &rc.heading_spacing);
+  r.read("paper.rc_car.heading_deviation", &rc.heading_deviation);
+}
+
 }  // namespace
 
 uint64_t derive_seed(uint64_t seed, uint64_t stream) {
@@ -257,6 +311,12 @@ std::string to_string(Scenario scenario) {
       return "mono";
   }
   return "?";
+}
+
+TargetMotion target_motion_from_string(const std::string& name) {
+  if (name == "semicircle") return TargetMotion::kSemicircle;
+  if (name == "rc_car") return TargetMotion::kRcCar;
+  throw std::invalid_argument("unknown target motion '" + name + "' (expected semicircle or rc_car)");
 }
 
 CameraAnchor camera_anchor_from_string(const std::string& name) {
@@ -378,7 +438,7 @@ SimConfig from_config(const Config& config) {
   r.read("target.min_view_cos", &c.target.min_view_cos);
 
   r.only_keys("paper", {"radius", "speed", "target_start_angle", "standoff", "lateral_offset", "height",
-                        "oscillation", "spline_dt"});
+                        "oscillation", "spline_dt", "target_motion", "rc_car"});
   r.read("paper.radius", &c.paper.radius);
   r.read("paper.speed", &c.paper.speed);
   r.read("paper.target_start_angle", &c.paper.target_start_angle);
@@ -387,6 +447,7 @@ SimConfig from_config(const Config& config) {
   r.read("paper.height", &c.paper.height);
   if (config.has("paper.oscillation")) r.read_sinusoid("paper.oscillation", &c.paper.oscillation);
   r.read("paper.spline_dt", &c.paper.spline_dt);
+  read_target_motion(config, r, &c.paper);
 
   r.only_keys("trajectory", {"file", "spline_dt", "start_distance"});
   if (config.has("trajectory.file")) {

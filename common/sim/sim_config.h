@@ -90,6 +90,34 @@ struct Sinusoid3 {
   Eigen::Vector3d phase{Eigen::Vector3d::Zero()};  // rad
 };
 
+// ---- Target motion of the paper scenario (issue 15) ----------------------
+
+enum class TargetMotion {
+  kSemicircle,  // constant speed and turn rate (the paper's Sec. IV)
+  kRcCar,       // RcCarConfig: speed and curvature varying, stops and starts
+};
+/// Parses "semicircle" / "rc_car"; throws std::invalid_argument.
+TargetMotion target_motion_from_string(const std::string& name);
+
+/// A ground vehicle driving like an RC car along a roughly semicircular
+/// course of arc length π·radius (common/sim/rc_car_course.h). Drawn from
+/// derive_seed(map_seed, ·), so Monte-Carlo runs share it as they share the map.
+struct RcCarConfig {
+  double speed_min{0.5};          // m/s, slowest cruising speed
+  double speed_max{2.5};          // m/s, fastest cruising speed
+  double max_acceleration{1.0};   // m/s², peak of every speed change
+  double hold_min{2.0};           // s, time at one speed
+  double hold_max{6.0};           // s
+  double stop_probability{0.15};  // per speed change: stop instead
+  double stop_min{1.0};           // s, standstill duration
+  double stop_max{3.0};           // s
+  /// The heading is the semicircle's plus a deviation δ(s), drawn at knots
+  /// every ~heading_spacing m of arc, δ ~ U[-heading_deviation,
+  /// heading_deviation], 0 at both ends (so the course turns by π).
+  double heading_spacing{20.0};   // m
+  double heading_deviation{0.25}; // rad
+};
+
 struct PaperScenarioConfig {
   double radius{50.0};          // m, radius of the target's semicircle
   double speed{1.5};            // m/s, target speed along the semicircle
@@ -102,6 +130,8 @@ struct PaperScenarioConfig {
   Sinusoid3 oscillation{Eigen::Vector3d(0.5, 0.6, 0.4), Eigen::Vector3d(0.07, 0.15, 0.15),
                         Eigen::Vector3d(0.0, 0.0, 1.0)};
   double spline_dt{0.1};        // s, control pose spacing of both splines
+  TargetMotion target_motion{TargetMotion::kSemicircle};
+  RcCarConfig rc_car;           // target_motion rc_car only
 };
 
 struct TrajectoryScenarioConfig {

@@ -80,7 +80,8 @@ int run(int argc, const char* const* argv) {
                  "(m / deg), over the camera frames after the target initialisation, and NEES.\n"
                  "Options not swept come from the target config's `target:` section.\n"
                  "Exit status: 0, 2 if a run diverged, 1 on bad input.");
-  args.add_option("sim-config", "FILE", "simulator scenario", "config/sim_paper.yaml");
+  args.add_option("sim-config", "FILE", "simulator scenario (config/sim_paper.yaml: the paper's semicircle)",
+                  "config/sim_paper_rc_car.yaml");
   args.add_option("vins-config", "FILE", "estimator config", "config/vins.yaml");
   args.add_option("target-config", "FILE", "target filter config (`target:` section)", "config/target_filter.yaml");
   args.add_option("sigmas", "LIST", "comma-separated σ_t values", "0.001,0.005,0.01,0.05,0.1,0.5");

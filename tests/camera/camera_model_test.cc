@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -19,6 +18,7 @@
 
 #include "common/camera/camera_model.h"
 #include "common/config/config.h"
+#include "tests/data_dir.h"
 
 using namespace vimot;
 
@@ -43,20 +43,11 @@ CameraCalibration strong_lens() {
   return c;
 }
 
-// The mav0 folder of the shared EuRoC excerpt, or "" (with a WARN saying why)
-// so the data-dependent tests pass as skipped when the data is absent.
+// The mav0 folder of the shared EuRoC excerpt, or "" (the test is then
+// reported as skipped, tests/data_dir.h).
 std::string euroc_mav0(const std::string& what) {
-  const char* root = std::getenv("VIMOT_DATA_DIR");
-  if (root == nullptr) {
-    WARN("VIMOT_DATA_DIR not set: skipping " << what);
-    return "";
-  }
-  const std::string mav0 = std::string(root) + "/euroc_v101_micro/mav0";
-  if (!std::ifstream(mav0 + "/cam0/sensor.yaml").good()) {
-    WARN("VIMOT_DATA_DIR=" << root << " has no euroc_v101_micro/mav0/cam0/sensor.yaml: skipping " << what);
-    return "";
-  }
-  return mav0;
+  const std::string sensor = vimot::test_data_file_or_skip("euroc_v101_micro/mav0/cam0/sensor.yaml", what);
+  return sensor.empty() ? "" : sensor.substr(0, sensor.size() - std::string("/cam0/sensor.yaml").size());
 }
 
 cv::Matx33d camera_matrix(const CameraCalibration& c) {
@@ -356,7 +347,7 @@ TEST_CASE("EuRoC stereo baseline is about 11 cm with cam0 left of cam1") {
   CHECK((R_C0toC1 - T_C1C0.topLeftCorner<3, 3>()).norm() < 1e-9);
 }
 
-TEST_CASE("config/euroc_stereo.yaml equals the EuRoC dataset calibration") {
+TEST_CASE("config/euroc_stereo.yaml equals the EuRoC dataset calibration", "[data]") {
   const std::string mav0 = euroc_mav0("comparing config/euroc_stereo.yaml with the EuRoC files");
   if (mav0.empty()) return;
   const std::vector<CameraCalibration> dataset = load_euroc_cameras(mav0);
@@ -384,7 +375,7 @@ TEST_CASE("config/euroc_stereo.yaml equals the EuRoC dataset calibration") {
   CHECK(imu_ref.get_matrix("T_BS", 4, 4) == Eigen::Matrix4d::Identity());
 }
 
-TEST_CASE("load_euroc_cameras reads the EuRoC files") {
+TEST_CASE("load_euroc_cameras reads the EuRoC files", "[data]") {
   const std::string mav0 = euroc_mav0("loading the EuRoC camera files");
   if (mav0.empty()) return;
   const std::vector<CameraCalibration> cams = load_euroc_cameras(mav0);

@@ -15,14 +15,6 @@ using namespace vimot::sim;
 
 namespace {
 
-// cam0 pose in G from the IMU pose and the calibration.
-void cam0_in_G(const Simulator& sim, double t, Eigen::Matrix3d* R_CtoG, Eigen::Vector3d* p_CinG) {
-  const SplineState I = sim.robot_state(t);
-  const CameraCalibration& calib = sim.cameras().at(0);
-  *R_CtoG = I.R_BtoG * calib.R_ItoC.transpose();
-  *p_CinG = I.p_BinG - *R_CtoG * calib.p_IinC;
-}
-
 double path_length_by_sampling(const Simulator& sim, double step) {
   double length = 0.0;
   Eigen::Vector3d prev = sim.robot_state(0.0).p_BinG;
@@ -64,7 +56,7 @@ TEST_CASE("Paper scenario: a 165 m UAV path following a planar target on a semic
     // UAV: cam0's optical axis on the target centre, x axis horizontal.
     Eigen::Matrix3d R_CtoG;
     Eigen::Vector3d p_C;
-    cam0_in_G(sim, t, &R_CtoG, &p_C);
+    test::cam0_in_G(sim, t, &R_CtoG, &p_C);
     const Eigen::Vector3d to_target = (T.p_BinG - p_C).normalized();
     max_cam_angle = std::max(max_cam_angle, std::acos(std::min(1.0, R_CtoG.col(2).dot(to_target))));
     max_x_tilt = std::max(max_x_tilt, std::abs(R_CtoG.col(0).z()));

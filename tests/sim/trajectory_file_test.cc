@@ -10,6 +10,7 @@
 
 #include "common/sim/simulator.h"
 #include "common/sim/trajectory_file.h"
+#include "tests/data_dir.h"
 #include "tests/sim/sim_test_util.h"
 
 using namespace vimot;
@@ -144,13 +145,10 @@ TEST_CASE("A trajectory scenario from a file written here follows the file's pos
   CHECK(frames == sim.camera_frame_count());
 }
 
-TEST_CASE("The shared corridor trajectory drives the simulator (needs VIMOT_DATA_DIR)") {
-  const char* data = std::getenv("VIMOT_DATA_DIR");
-  if (data == nullptr || *data == '\0') {
-    WARN("VIMOT_DATA_DIR not set: skipping the shared trajectory file test");
-    return;
-  }
-  const std::string path = std::string(data) + "/sim_trajectories/tum_corridor1_512_16_okvis.txt";
+TEST_CASE("The shared corridor trajectory drives the simulator (needs VIMOT_DATA_DIR)", "[data]") {
+  const std::string path =
+      vimot::test_data_file_or_skip("sim_trajectories/tum_corridor1_512_16_okvis.txt", "the shared trajectory file test");
+  if (path.empty()) return;
   const PoseTrajectory traj = load_tum_trajectory(path);
   CHECK(traj.poses.size() == 5986);
   CHECK(traj.poses.back().t == Approx(299.26).margin(0.01));
