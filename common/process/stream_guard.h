@@ -1,5 +1,5 @@
 #pragma once
-// Timing guard of one input stream (IMU, FEATURES, GROUND_TRUTH) of a node:
+// Timing guard of one input stream (IMU, FEATURES) of a node:
 // bounds how far one message may jump from the stream's clock, tells a
 // single bad timestamp (rejected, the clock kept) from a source whose clock
 // really moved (several consistent jumps: a source reset), and counts input

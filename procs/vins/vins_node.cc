@@ -11,7 +11,7 @@
 namespace vimot {
 
 void InputGuardOptions::validate() const {
-  for (const StreamGuardOptions* s : {&imu, &features, &ground_truth}) s->validate();
+  for (const StreamGuardOptions* s : {&imu, &features}) s->validate();
   if (!(max_gyro_radps > 0.0)) throw std::invalid_argument("max_gyro_radps: must be > 0");
   if (!(max_accel_mps2 > 0.0)) throw std::invalid_argument("max_accel_mps2: must be > 0");
   if (!(max_imu_gap_s > 0.0)) throw std::invalid_argument("max_imu_gap_s: must be > 0");
@@ -29,12 +29,12 @@ void InputGuardOptions::validate() const {
 InputGuardOptions input_guard_options_from_config(const Config& cfg) {
   InputGuardOptions o;
   if (!cfg.has("input")) return o;
-  cfg.check_keys("input", {"imu", "features", "ground_truth", "source_reset_after", "max_gyro_radps",
+  cfg.check_keys("input", {"imu", "features", "source_reset_after", "max_gyro_radps",
                            "max_accel_mps2", "max_imu_gap_s", "max_rejected_frames", "consistency_window",
                            "consistency_min_tests", "max_chi2_failure_fraction", "max_quat_norm_error"});
   const int reset_after = cfg.get_or<int>("input.source_reset_after", o.imu.reset_after);
   const std::pair<const char*, StreamGuardOptions*> streams[] = {
-      {"imu", &o.imu}, {"features", &o.features}, {"ground_truth", &o.ground_truth}};
+      {"imu", &o.imu}, {"features", &o.features}};
   for (const auto& [name, s] : streams) {
     const std::string k = std::string("input.") + name;
     cfg.check_keys(k, {"rate_hz", "max_forward_jump_s", "max_backward_jump_s"});
@@ -92,8 +92,7 @@ VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, Event
       on_state_(std::move(on_state)),
       on_event_(std::move(on_event)),
       imu_guard_("IMU", options.input.imu),
-      frame_guard_("FEATURES", options.input.features),
-      truth_guard_("GROUND_TRUTH", options.input.ground_truth) {
+      frame_guard_("FEATURES", options.input.features) {
   options_.input.validate();
 }
 
@@ -125,7 +124,7 @@ void VinsNode::reset_estimate(const std::string& why, bool clean_clock) {
     estimator_.clear_imu();
     queued_frames_.clear();
     last_frame_utime_ = -1;
-    for (StreamGuard* g : {&imu_guard_, &frame_guard_, &truth_guard_}) g->reset();
+    for (StreamGuard* g : {&imu_guard_, &frame_guard_}) g->reset();
   }
   say(NodeEvent::Kind::kError, why + "; reset, re-initialising " +
                                    (options_.init_from_ground_truth ? "from ground truth" : "at rest"));
@@ -229,10 +228,11 @@ bool VinsNode::check_ground_truth(GroundTruth* truth) {
 void VinsNode::on_ground_truth(const GroundTruth& message) {
   guarded("on_ground_truth", [&] {
     GroundTruth truth = message;
-    if (!check_ground_truth(&truth) || !admit(truth_guard_, truth.utime)) return;
+    if (!check_ground_truth(&truth)) return;
     if (!options_.init_from_ground_truth || estimator_.initialized()) return;
     // A start far from the IMU's clock (a future or stale ground truth)
     // would make every frame "before the state time": wait for a good one.
+    // Checked before the stream's own clock, so such a message never sets it.
     const int64_t imu_utime = estimator_.propagator().latest_utime();
     if (imu_utime >= 0 && std::abs(1e-6 * static_cast<double>(truth.utime - imu_utime)) > options_.input.max_imu_gap_s) {
       say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth.utime) +

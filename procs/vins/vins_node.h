@@ -31,11 +31,11 @@ namespace vimot {
 struct InputGuardOptions {
   StreamGuardOptions imu{0.0, 0.5, 0.5, 3};
   StreamGuardOptions features{0.0, 2.0, 0.5, 3};
-  StreamGuardOptions ground_truth{0.0, 2.0, 0.5, 3};
   double max_gyro_radps{35.0};   // |ω| above: rejected (2000 °/s, a MEMS gyro's full scale)
   double max_accel_mps2{160.0};  // |a| above: rejected (16 g)
   /// A frame more than this after the newest IMU sample (IMU lost while
-  /// frames continue), or propagated across a longer IMU gap: reset.
+  /// frames continue), or propagated across a longer IMU gap: reset. Also
+  /// how close to the IMU clock a ground truth must be to start from.
   double max_imu_gap_s{0.5};
   /// Consecutive frames the estimator rejects as not after its state time
   /// (its clock is wrong, e.g. started from a future ground truth): reset.
@@ -141,7 +141,6 @@ class VinsNode {
   int64_t resets_{0};
   StreamGuard imu_guard_;
   StreamGuard frame_guard_;
-  StreamGuard truth_guard_;
   int rejected_frames_{0};
   struct GateCounts {
     int tested{0};
