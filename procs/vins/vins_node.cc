@@ -75,13 +75,15 @@ bool validate_quaternion(Eigen::Vector4d* q, double max_norm_error, std::string*
 
 VinsNodeOptions vins_node_options_from_config(const Config& cfg) {
   cfg.check_keys("", estimator::vins_config_keys());
-  cfg.check_keys("output", {"imu_rate"});
+  cfg.check_keys("output", {"imu_rate", "imu_rate_every"});
   VinsNodeOptions options;
   options.vio = estimator::vio_options_from_config(cfg);
   const estimator::VinsStartOptions start = estimator::start_options_from_config(cfg);
   options.init_from_ground_truth = start.mode == estimator::InitMode::kGroundTruth;
   options.perturb_seed = start.perturb_seed;
   options.publish_imu_rate = cfg.get_or<bool>("output.imu_rate", options.publish_imu_rate);
+  options.imu_rate_every = cfg.get_or<int>("output.imu_rate_every", options.imu_rate_every);
+  if (options.imu_rate_every < 1) cfg.fail("output.imu_rate_every", "must be >= 1");
   options.input = input_guard_options_from_config(cfg);
   return options;
 }
@@ -343,6 +345,7 @@ void VinsNode::publish_updated() {
 
 void VinsNode::publish_propagated(int64_t utime) {
   if (!on_state_ || !estimator_.initialized() || utime <= estimator_.state_utime()) return;
+  if (imu_rate_count_++ % options_.imu_rate_every != 0) return;
   // Output only: predicts the IMU marginal from the last update without
   // touching the filter, so IMU-rate output never changes the estimate.
   const estimator::ImuValue x0 = estimator_.imu_value();

@@ -71,6 +71,10 @@ struct VinsNodeOptions {
   uint64_t perturb_seed{0};
   /// Publish the IMU-rate propagated state (VINS_STATE, updated = false).
   bool publish_imu_rate{true};
+  /// ... every this many IMU samples (>= 1). Each carries a full 15×15
+  /// covariance (≈ 2 kB) into every subscriber's socket; the camera-rate
+  /// consumers (scale_estimator, log evaluation) need only updated states.
+  int imu_rate_every{1};
   /// Frames queued while waiting for IMU beyond this many are processed
   /// anyway (IMU stream stalled) — bounded memory and latency.
   int max_queued_frames{5};
@@ -142,6 +146,7 @@ class VinsNode {
   StreamGuard imu_guard_;
   StreamGuard frame_guard_;
   int rejected_frames_{0};
+  int64_t imu_rate_count_{0};
   struct GateCounts {
     int tested{0};
     int failed{0};
