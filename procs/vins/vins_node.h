@@ -9,6 +9,11 @@
 // the process ran out). IMU samples are buffered by the estimator, so the
 // frame sees exactly the IMU data up to its time however the two channels
 // interleave on the network.
+//
+// Input guards (InputGuardOptions, docs/robustness.md): absurd or mistimed
+// input is dropped and said, lost input counted, and a moved source clock,
+// an IMU gap, a wrong filter clock or an inconsistent filter resets the
+// estimate, said as an error. No exception leaves a public call.
 
 #include <cstdint>
 #include <deque>

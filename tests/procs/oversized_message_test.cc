@@ -3,6 +3,7 @@
 // observations. Each must count every one as a decode error, stay small
 // (before the length check each such message allocated ~5 GB), log a few
 // lines instead of one per message, and still exit cleanly on SIGTERM.
+// Items 3 and 6: lost and future IMU samples counted in a degraded heartbeat.
 #include <catch2/catch.hpp>
 
 #include <fcntl.h>
