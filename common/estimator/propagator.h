@@ -129,6 +129,8 @@ class Propagator {
 
   /// Drops samples older than utime, keeping one before it for interpolation.
   void clean_older_than(int64_t utime);
+  /// Drops every buffered sample (the counts stay).
+  void clear() { buffer_.clear(); }
 
   /// The IMU prediction over [t0, t1] without touching a state: the mean x1
   /// from x0, and (if Phi/Q are given) the interval's Φ = ∏Φ_i and Q

@@ -20,7 +20,8 @@ InitMode read_mode(const Config& cfg) {
 }  // namespace
 
 const std::vector<std::string>& vins_config_keys() {
-  static const std::vector<std::string> keys = {"calibration_file", "channels", "init", "estimator", "output"};
+  static const std::vector<std::string> keys = {"calibration_file", "channels", "init", "estimator", "output",
+                                                "input"};
   return keys;
 }
 

@@ -135,6 +135,8 @@ class VioEstimator {
   /// Back to uninitialised: state, window, landmarks and tracks dropped;
   /// the IMU buffer is kept.
   void reset();
+  /// Also drops the buffered IMU data (a source whose clock moved).
+  void clear_imu() { propagator_.clear(); }
 
   /// Called once per divergence detection (covariance non-finite or with a
   /// negative diagonal, non-finite state, too large a correction, too high a

@@ -3,13 +3,17 @@
 // counters and log (common/process/node_runner.h). Nodes hold the process
 // logic without LCM, so this header has none either.
 
+#include <cstdint>
 #include <string>
 
 namespace vimot {
 
 struct NodeEvent {
-  enum class Kind { kInfo, kDropped, kError } kind{Kind::kInfo};
+  /// kLost: `count` messages of a stream never arrived (utime gap);
+  /// kError: also a reset of the estimate (the heartbeat says degraded).
+  enum class Kind { kInfo, kDropped, kError, kLost } kind{Kind::kInfo};
   std::string message;
+  int64_t count{1};
 };
 
 }  // namespace vimot

@@ -96,6 +96,11 @@ void Process::set_counter(const std::string& name, int64_t value) {
   extra_counters_.emplace_back(name, value);
 }
 
+void Process::report_lost(int64_t count, const std::string& why) {
+  counters_.lost += count;
+  log_warn("lost: ", why);
+}
+
 bool Process::stop_requested() const { return stop_requested_ || g_signal_received; }
 
 void Process::publish_heartbeat() {
@@ -106,9 +111,13 @@ void Process::publish_heartbeat() {
   hb.messages_in = counters_.messages_in;
   hb.messages_out = counters_.messages_out;
   hb.decode_errors = counters_.decode_errors;
-  hb.dropped = counters_.dropped;
+  hb.dropped = counters_.dropped + counters_.lost;
   hb.errors = counters_.errors;
-  hb.status = counters_.errors > 0 ? "degraded" : "ok";
+  // Anything not used as it came (dropped, lost, undecodable) or an error
+  // (a reset of the estimate included) makes the output suspect.
+  const bool degraded =
+      counters_.errors > 0 || counters_.dropped > 0 || counters_.lost > 0 || counters_.decode_errors > 0;
+  hb.status = degraded ? "degraded" : "ok";
   hb.last_error = last_error_;
   hb.num_counters = static_cast<int32_t>(extra_counters_.size());
   for (const auto& [n, v] : extra_counters_) {
@@ -137,7 +146,7 @@ int Process::run(const std::function<void()>& idle) {
   }
   flush_suppressed_logs();
   log_info("stopping: in ", counters_.messages_in.load(), ", out ", counters_.messages_out.load(),
-           ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(),
+           ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(), ", lost ", counters_.lost.load(),
            ", errors ", counters_.errors.load());
   return 0;
 }

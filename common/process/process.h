@@ -34,6 +34,7 @@ struct ProcessCounters {
   std::atomic<int64_t> decode_errors{0};
   std::atomic<int64_t> dropped{0};
   std::atomic<int64_t> errors{0};
+  std::atomic<int64_t> lost{0};  // input that never arrived (utime gaps), in the heartbeat's `dropped`
 };
 
 class Process {
@@ -80,6 +81,9 @@ class Process {
   void report_error(const std::string& what);
   /// Counts dropped input (late, duplicate, out-of-order) with a reason.
   void report_dropped(const std::string& why);
+  /// Counts `count` input messages that never arrived (a gap in a stream's
+  /// utime against its expected rate).
+  void report_lost(int64_t count, const std::string& why);
 
   /// Sets a process-specific cumulative counter carried by the heartbeat
   /// (counter_names / counter_values, in first-set order). Call from the

@@ -17,10 +17,19 @@ namespace {
 constexpr double kGlNodes[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
 constexpr double kGlWeights[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
 
-// Sub-intervals so that each one rotates by at most 0.25 rad.
+// Sub-intervals so that each one rotates by at most 0.25 rad. Bounded: a
+// longer step (a future timestamp, an absurd rate) is an error, never a
+// loop the caller cannot afford (1000 sub-intervals ≈ 40 turns, < 1 ms).
+constexpr int kMaxSubintervals = 1000;
 int num_subintervals(const Eigen::Vector3d& w, double dt) {
-  const double angle = w.norm() * dt;
-  return std::max(1, static_cast<int>(std::ceil(angle / 0.25)));
+  const double n = std::ceil(w.norm() * dt / 0.25);
+  if (!(n <= kMaxSubintervals)) {
+    std::ostringstream msg;
+    msg << "target propagation: rotation |w| dt = " << w.norm() * dt << " rad over " << dt
+        << " s is beyond a meaningful prediction (limit " << 0.25 * kMaxSubintervals << " rad)";
+    throw std::invalid_argument(msg.str());
+  }
+  return std::max(1, static_cast<int>(n));
 }
 
 void check_inputs(double dt, const TargetNoise& noise) {

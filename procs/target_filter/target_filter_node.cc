@@ -38,6 +38,7 @@ TargetFilterNodeOptions node_options_from_config(const Config& cfg) {
   options.perturb_seed = start.perturb_seed;
   options.publish_imu_rate = cfg.get_or<bool>("output.imu_rate", options.publish_imu_rate);
   target_options_from_config(cfg, &options);
+  options.input = input_guard_options_from_config(vins);
   return options;
 }
 
@@ -71,6 +72,7 @@ VinsNodeOptions vins_node_options(const TargetFilterNodeOptions& o) {
   v.perturb_seed = o.perturb_seed;
   v.publish_imu_rate = o.publish_imu_rate;
   v.max_queued_frames = o.max_queued_frames;
+  v.input = o.input;
   return v;
 }
 }  // namespace
@@ -103,7 +105,9 @@ void TargetFilterNode::on_frame(const CameraFrame& frame) { vins_.on_frame(frame
 
 void TargetFilterNode::flush() { vins_.flush(); }
 
-void TargetFilterNode::on_ground_truth(const GroundTruth& truth) {
+void TargetFilterNode::on_ground_truth(const GroundTruth& message) {
+  GroundTruth truth = message;
+  if (!vins_.check_ground_truth(&truth)) return;  // unit quaternions from here on
   if (filter_ && truth.has_target && options_.target.init_mode == target::TargetInitMode::kGroundTruth) {
     truths_[truth.utime] = truth;
     const int64_t keep_from = truth.utime - static_cast<int64_t>(options_.ground_truth_buffer_s * 1e6);

@@ -50,6 +50,8 @@ struct TargetFilterNodeOptions {
   int max_queued_frames{5};
   /// Ground truth kept for the target initialisation (s of history).
   double ground_truth_buffer_s{2.0};
+  /// Input guards (`input` section of the vins config), see VinsNodeOptions.
+  InputGuardOptions input;
 };
 
 /// The process's options from config/target_filter.yaml:

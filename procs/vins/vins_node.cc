@@ -1,6 +1,8 @@
 #include "procs/vins/vins_node.h"
 
+#include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "common/estimator/initial_estimate.h"
 #include "common/estimator/nav_state_of.h"
@@ -8,20 +10,93 @@
 
 namespace vimot {
 
+void InputGuardOptions::validate() const {
+  for (const StreamGuardOptions* s : {&imu, &features}) s->validate();
+  if (!(max_gyro_radps > 0.0)) throw std::invalid_argument("max_gyro_radps: must be > 0");
+  if (!(max_accel_mps2 > 0.0)) throw std::invalid_argument("max_accel_mps2: must be > 0");
+  if (!(max_imu_gap_s > 0.0)) throw std::invalid_argument("max_imu_gap_s: must be > 0");
+  if (max_rejected_frames < 1) throw std::invalid_argument("max_rejected_frames: must be >= 1");
+  if (consistency_window < 1) throw std::invalid_argument("consistency_window: must be >= 1");
+  if (consistency_min_tests < 1) throw std::invalid_argument("consistency_min_tests: must be >= 1");
+  if (!(max_chi2_failure_fraction > 0.0 && max_chi2_failure_fraction <= 1.0)) {
+    throw std::invalid_argument("max_chi2_failure_fraction: must be in (0, 1]");
+  }
+  if (!(max_quat_norm_error >= 0.0 && max_quat_norm_error < 1.0)) {
+    throw std::invalid_argument("max_quat_norm_error: must be in [0, 1)");
+  }
+}
+
+InputGuardOptions input_guard_options_from_config(const Config& cfg) {
+  InputGuardOptions o;
+  if (!cfg.has("input")) return o;
+  cfg.check_keys("input", {"imu", "features", "source_reset_after", "max_gyro_radps",
+                           "max_accel_mps2", "max_imu_gap_s", "max_rejected_frames", "consistency_window",
+                           "consistency_min_tests", "max_chi2_failure_fraction", "max_quat_norm_error"});
+  const int reset_after = cfg.get_or<int>("input.source_reset_after", o.imu.reset_after);
+  const std::pair<const char*, StreamGuardOptions*> streams[] = {
+      {"imu", &o.imu}, {"features", &o.features}};
+  for (const auto& [name, s] : streams) {
+    const std::string k = std::string("input.") + name;
+    cfg.check_keys(k, {"rate_hz", "max_forward_jump_s", "max_backward_jump_s"});
+    const double rate = cfg.get_or<double>(k + ".rate_hz", 0.0);
+    if (!(rate >= 0.0) || !std::isfinite(rate)) cfg.fail(k + ".rate_hz", "must be finite and >= 0");
+    s->expected_period_s = rate > 0.0 ? 1.0 / rate : 0.0;
+    s->max_forward_jump_s = cfg.get_or<double>(k + ".max_forward_jump_s", s->max_forward_jump_s);
+    s->max_backward_jump_s = cfg.get_or<double>(k + ".max_backward_jump_s", s->max_backward_jump_s);
+    s->reset_after = reset_after;
+  }
+  o.max_gyro_radps = cfg.get_or<double>("input.max_gyro_radps", o.max_gyro_radps);
+  o.max_accel_mps2 = cfg.get_or<double>("input.max_accel_mps2", o.max_accel_mps2);
+  o.max_imu_gap_s = cfg.get_or<double>("input.max_imu_gap_s", o.max_imu_gap_s);
+  o.max_rejected_frames = cfg.get_or<int>("input.max_rejected_frames", o.max_rejected_frames);
+  o.consistency_window = cfg.get_or<int>("input.consistency_window", o.consistency_window);
+  o.consistency_min_tests = cfg.get_or<int>("input.consistency_min_tests", o.consistency_min_tests);
+  o.max_chi2_failure_fraction = cfg.get_or<double>("input.max_chi2_failure_fraction", o.max_chi2_failure_fraction);
+  o.max_quat_norm_error = cfg.get_or<double>("input.max_quat_norm_error", o.max_quat_norm_error);
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(cfg.source() + ": input." + e.what());
+  }
+  return o;
+}
+
+bool validate_quaternion(Eigen::Vector4d* q, double max_norm_error, std::string* why) {
+  const double n = q->norm();
+  if (!std::isfinite(n) || std::abs(n - 1.0) > max_norm_error) {
+    std::ostringstream msg;
+    msg << "quaternion norm " << n << " is not 1 (tolerance " << max_norm_error << ")";
+    *why = msg.str();
+    return false;
+  }
+  *q /= n;
+  return true;
+}
+
 VinsNodeOptions vins_node_options_from_config(const Config& cfg) {
   cfg.check_keys("", estimator::vins_config_keys());
-  cfg.check_keys("output", {"imu_rate"});
+  cfg.check_keys("output", {"imu_rate", "imu_rate_every"});
   VinsNodeOptions options;
   options.vio = estimator::vio_options_from_config(cfg);
   const estimator::VinsStartOptions start = estimator::start_options_from_config(cfg);
   options.init_from_ground_truth = start.mode == estimator::InitMode::kGroundTruth;
   options.perturb_seed = start.perturb_seed;
   options.publish_imu_rate = cfg.get_or<bool>("output.imu_rate", options.publish_imu_rate);
+  options.imu_rate_every = cfg.get_or<int>("output.imu_rate_every", options.imu_rate_every);
+  if (options.imu_rate_every < 1) cfg.fail("output.imu_rate_every", "must be >= 1");
+  options.input = input_guard_options_from_config(cfg);
   return options;
 }
 
 VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, EventCallback on_event)
-    : options_(options), estimator_(options.vio), on_state_(std::move(on_state)), on_event_(std::move(on_event)) {}
+    : options_(options),
+      estimator_(options.vio),
+      on_state_(std::move(on_state)),
+      on_event_(std::move(on_event)),
+      imu_guard_("IMU", options.input.imu),
+      frame_guard_("FEATURES", options.input.features) {
+  options_.input.validate();
+}
 
 void VinsNode::set_frame_hooks(std::function<void(const CameraFrame&)> before_frame,
                                std::function<void()> after_update) {
@@ -33,7 +108,62 @@ void VinsNode::say(NodeEvent::Kind kind, const std::string& message) {
   if (on_event_) on_event_(NodeEvent{kind, message});
 }
 
+template <typename F>
+void VinsNode::guarded(const char* where, F&& body) {
+  try {
+    body();
+  } catch (const std::exception& e) {
+    reset_estimate(std::string("internal error in ") + where + ": " + e.what(), /*clean_clock=*/false);
+  }
+}
+
+void VinsNode::reset_estimate(const std::string& why, bool clean_clock) {
+  ++resets_;
+  estimator_.reset();
+  gate_window_.clear();
+  rejected_frames_ = 0;
+  if (clean_clock) {
+    estimator_.clear_imu();
+    queued_frames_.clear();
+    last_frame_utime_ = -1;
+    for (StreamGuard* g : {&imu_guard_, &frame_guard_}) g->reset();
+  }
+  say(NodeEvent::Kind::kError, why + "; reset, re-initialising " +
+                                   (options_.init_from_ground_truth ? "from ground truth" : "at rest"));
+}
+
+bool VinsNode::admit(StreamGuard& guard, int64_t utime) {
+  const StreamCheck c = guard.check(utime);
+  switch (c.verdict) {
+    case StreamVerdict::kAccept:
+      if (c.lost > 0 && on_event_) on_event_(NodeEvent{NodeEvent::Kind::kLost, c.message, c.lost});
+      return true;
+    case StreamVerdict::kRejectJump:
+      say(NodeEvent::Kind::kDropped, c.message);
+      return false;
+    case StreamVerdict::kSourceReset:
+      reset_estimate(c.message, /*clean_clock=*/true);
+      guard.check(utime);  // the new clock starts here
+      return true;
+  }
+  return false;
+}
+
 void VinsNode::on_imu(const ImuData& imu) {
+  guarded("on_imu", [&] { on_imu_checked(imu); });
+}
+
+void VinsNode::on_imu_checked(const ImuData& imu) {
+  if (imu.w_IinI.allFinite() && imu.a_IinI.allFinite() &&
+      (imu.w_IinI.norm() > options_.input.max_gyro_radps || imu.a_IinI.norm() > options_.input.max_accel_mps2)) {
+    std::ostringstream msg;
+    msg << "IMU sample at utime " << imu.utime << " out of range: |w| " << imu.w_IinI.norm() << " rad/s (limit "
+        << options_.input.max_gyro_radps << "), |a| " << imu.a_IinI.norm() << " m/s^2 (limit "
+        << options_.input.max_accel_mps2 << ")";
+    say(NodeEvent::Kind::kDropped, msg.str());
+    return;
+  }
+  if (!admit(imu_guard_, imu.utime)) return;
   const estimator::ImuFeedStatus status = estimator_.feed_imu(imu);
   switch (status) {
     case estimator::ImuFeedStatus::kAccepted:
@@ -51,6 +181,11 @@ void VinsNode::on_imu(const ImuData& imu) {
 }
 
 void VinsNode::on_frame(const CameraFrame& frame) {
+  guarded("on_frame", [&] { on_frame_checked(frame); });
+}
+
+void VinsNode::on_frame_checked(const CameraFrame& frame) {
+  if (!admit(frame_guard_, frame.utime)) return;
   if (frame.utime <= last_frame_utime_) {
     say(NodeEvent::Kind::kDropped, "camera frame at utime " + std::to_string(frame.utime) +
                                        (frame.utime == last_frame_utime_ ? " is a duplicate" : " is out of order"));
@@ -62,20 +197,56 @@ void VinsNode::on_frame(const CameraFrame& frame) {
   while (static_cast<int>(queued_frames_.size()) > options_.max_queued_frames) {
     say(NodeEvent::Kind::kInfo, "IMU stalled: processing frame " + std::to_string(queued_frames_.front().utime) +
                                     " without IMU up to its time");
-    process_frame(queued_frames_.front());
+    const CameraFrame stalled = std::move(queued_frames_.front());
     queued_frames_.pop_front();
+    process_frame(stalled);
   }
 }
 
 void VinsNode::flush() {
-  while (!queued_frames_.empty()) {
-    process_frame(queued_frames_.front());
-    queued_frames_.pop_front();
-  }
+  guarded("flush", [&] {
+    while (!queued_frames_.empty()) {
+      // Popped first: a frame that throws is not retried forever.
+      const CameraFrame frame = std::move(queued_frames_.front());
+      queued_frames_.pop_front();
+      process_frame(frame);
+    }
+  });
 }
 
-void VinsNode::on_ground_truth(const GroundTruth& truth) {
-  if (!options_.init_from_ground_truth || estimator_.initialized()) return;
+bool VinsNode::check_ground_truth(GroundTruth* truth) {
+  std::string why;
+  const bool ok = truth->p_IinG.allFinite() && truth->v_IinG.allFinite() &&
+                  validate_quaternion(&truth->q_GtoI, options_.input.max_quat_norm_error, &why) &&
+                  (!truth->has_target ||
+                   validate_quaternion(&truth->q_GtoT, options_.input.max_quat_norm_error, &why));
+  if (!ok) {
+    say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth->utime) + ": " +
+                                       (why.empty() ? std::string("non-finite position or velocity") : why));
+  }
+  return ok;
+}
+
+void VinsNode::on_ground_truth(const GroundTruth& message) {
+  guarded("on_ground_truth", [&] {
+    GroundTruth truth = message;
+    if (!check_ground_truth(&truth)) return;
+    if (!options_.init_from_ground_truth || estimator_.initialized()) return;
+    // A start far from the IMU's clock (a future or stale ground truth)
+    // would make every frame "before the state time": wait for a good one.
+    // Checked before the stream's own clock, so such a message never sets it.
+    const int64_t imu_utime = estimator_.propagator().latest_utime();
+    if (imu_utime >= 0 && std::abs(1e-6 * static_cast<double>(truth.utime - imu_utime)) > options_.input.max_imu_gap_s) {
+      say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth.utime) +
+                                         " is too far from the IMU clock (" + std::to_string(imu_utime) +
+                                         ") to initialise from");
+      return;
+    }
+    initialise_from(truth);
+  });
+}
+
+void VinsNode::initialise_from(const GroundTruth& truth) {
   const estimator::InitialEstimate init = estimator::initial_estimate(truth, options_.vio, options_.perturb_seed);
   estimator_.initialize(init.value, truth.utime, init.P0);
   say(NodeEvent::Kind::kInfo, "initialised from ground truth at utime " + std::to_string(truth.utime));
@@ -83,28 +254,57 @@ void VinsNode::on_ground_truth(const GroundTruth& truth) {
 
 void VinsNode::process_ready_frames(int64_t latest_imu_utime) {
   while (!queued_frames_.empty() && queued_frames_.front().utime <= latest_imu_utime) {
-    process_frame(queued_frames_.front());
+    const CameraFrame frame = std::move(queued_frames_.front());
     queued_frames_.pop_front();
+    process_frame(frame);
   }
 }
 
 void VinsNode::process_frame(const CameraFrame& frame) {
-  if (before_frame_) before_frame_(frame);
-  const estimator::FrameStatus status = estimator_.feed_camera(frame);
-  switch (status) {
-    case estimator::FrameStatus::kProcessed:
-      publish_updated();
-      if (after_update_) after_update_();
-      return;
-    case estimator::FrameStatus::kDiverged: {
-      ++resets_;
-      std::ostringstream msg;
-      msg << "estimator diverged at utime " << frame.utime << " (" << estimator_.last_divergence().reason
-          << "); reset, re-initialising " << (options_.init_from_ground_truth ? "from ground truth" : "at rest");
-      estimator_.reset();
-      say(NodeEvent::Kind::kError, msg.str());
+  if (estimator_.initialized()) {
+    // IMU lost while frames continue: propagating blind would drift without
+    // bound while every output looks fine.
+    const double ahead_s = 1e-6 * static_cast<double>(frame.utime - estimator_.propagator().latest_utime());
+    if (ahead_s > options_.input.max_imu_gap_s) {
+      reset_estimate("no IMU for " + std::to_string(ahead_s) + " s at frame utime " + std::to_string(frame.utime) +
+                         " (limit " + std::to_string(options_.input.max_imu_gap_s) + " s)",
+                     /*clean_clock=*/false);
       return;
     }
+  }
+  if (before_frame_) before_frame_(frame);
+  const estimator::FrameStatus status = estimator_.feed_camera(frame);
+  rejected_frames_ = status == estimator::FrameStatus::kRejectedOutOfOrder ? rejected_frames_ + 1 : 0;
+  switch (status) {
+    case estimator::FrameStatus::kProcessed: {
+      const estimator::PropagationReport& prop = estimator_.last_propagation();
+      if (prop.max_step_s > options_.input.max_imu_gap_s) {
+        reset_estimate("frame at utime " + std::to_string(frame.utime) + " propagated across an IMU gap of " +
+                           std::to_string(prop.max_step_s) + " s (limit " +
+                           std::to_string(options_.input.max_imu_gap_s) + " s)",
+                       /*clean_clock=*/false);
+        return;
+      }
+      publish_updated();
+      if (after_update_) after_update_();
+      check_consistency();
+      return;
+    }
+    case estimator::FrameStatus::kDiverged:
+      reset_estimate("estimator diverged at utime " + std::to_string(frame.utime) + " (" +
+                         estimator_.last_divergence().reason + ")",
+                     /*clean_clock=*/false);
+      return;
+    case estimator::FrameStatus::kRejectedOutOfOrder:
+      if (rejected_frames_ >= options_.input.max_rejected_frames) {
+        reset_estimate(std::to_string(rejected_frames_) + " consecutive frames before the estimator's state time " +
+                           std::to_string(estimator_.state_utime()) + " (its clock is wrong)",
+                       /*clean_clock=*/false);
+        return;
+      }
+      say(NodeEvent::Kind::kDropped,
+          "frame at utime " + std::to_string(frame.utime) + ": " + estimator::to_string(status));
+      return;
     case estimator::FrameStatus::kNotInitialized:
       say(NodeEvent::Kind::kDropped, "frame at utime " + std::to_string(frame.utime) + " before initialisation");
       return;
@@ -115,12 +315,37 @@ void VinsNode::process_frame(const CameraFrame& frame) {
   }
 }
 
+void VinsNode::check_consistency() {
+  const estimator::UpdateStats& s = estimator_.last_stats();
+  GateCounts g;
+  g.failed = s.msckf_rejected_chi2 + s.slam_rejected_chi2;
+  g.tested = s.msckf_used + s.slam_updated + g.failed;
+  gate_window_.push_back(g);
+  if (static_cast<int>(gate_window_.size()) > options_.input.consistency_window) gate_window_.pop_front();
+  GateCounts sum;
+  for (const GateCounts& w : gate_window_) {
+    sum.tested += w.tested;
+    sum.failed += w.failed;
+  }
+  if (static_cast<int>(gate_window_.size()) < options_.input.consistency_window ||
+      sum.tested < options_.input.consistency_min_tests ||
+      sum.failed <= options_.input.max_chi2_failure_fraction * sum.tested) {
+    return;
+  }
+  std::ostringstream msg;
+  msg << "filter inconsistent at utime " << estimator_.state_utime() << ": " << sum.failed << " of " << sum.tested
+      << " features failed the chi2 gate over the last " << gate_window_.size() << " frames (limit "
+      << options_.input.max_chi2_failure_fraction << ", about 0.05 when consistent)";
+  reset_estimate(msg.str(), /*clean_clock=*/false);
+}
+
 void VinsNode::publish_updated() {
   if (on_state_) on_state_(estimator::nav_state_of(estimator_, /*updated=*/true));
 }
 
 void VinsNode::publish_propagated(int64_t utime) {
   if (!on_state_ || !estimator_.initialized() || utime <= estimator_.state_utime()) return;
+  if (imu_rate_count_++ % options_.imu_rate_every != 0) return;
   // Output only: predicts the IMU marginal from the last update without
   // touching the filter, so IMU-rate output never changes the estimate.
   const estimator::ImuValue x0 = estimator_.imu_value();

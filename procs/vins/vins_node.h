@@ -9,6 +9,11 @@
 // the process ran out). IMU samples are buffered by the estimator, so the
 // frame sees exactly the IMU data up to its time however the two channels
 // interleave on the network.
+//
+// Input guards (InputGuardOptions, docs/robustness.md): absurd or mistimed
+// input is dropped and said, lost input counted, and a moved source clock,
+// an IMU gap, a wrong filter clock or an inconsistent filter resets the
+// estimate, said as an error. No exception leaves a public call.
 
 #include <cstdint>
 #include <deque>
@@ -18,11 +23,49 @@
 #include "common/config/config.h"
 #include "common/estimator/vio_estimator.h"
 #include "common/process/node_event.h"
+#include "common/process/stream_guard.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
 #include "common/types/sensor_data.h"
 
 namespace vimot {
+
+/// What the node accepts and when it resets (config section `input`,
+/// docs/robustness.md). Defaults: no loss counting (rates unknown), limits
+/// far outside clean input, so clean input is processed unchanged.
+struct InputGuardOptions {
+  StreamGuardOptions imu{0.0, 0.5, 0.5, 3};
+  StreamGuardOptions features{0.0, 2.0, 0.5, 3};
+  double max_gyro_radps{35.0};   // |ω| above: rejected (2000 °/s, a MEMS gyro's full scale)
+  double max_accel_mps2{160.0};  // |a| above: rejected (16 g)
+  /// A frame more than this after the newest IMU sample (IMU lost while
+  /// frames continue), or propagated across a longer IMU gap: reset. Also
+  /// how close to the IMU clock a ground truth must be to start from.
+  double max_imu_gap_s{0.5};
+  /// Consecutive frames the estimator rejects as not after its state time
+  /// (its clock is wrong, e.g. started from a future ground truth): reset.
+  int max_rejected_frames{3};
+  /// Filter consistency: over the last `consistency_window` processed frames
+  /// with at least `consistency_min_tests` χ²-gated features, a fraction of
+  /// gate failures above this (a consistent filter fails ≈ 5 % at the
+  /// 95 % gate) means divergence: reset.
+  int consistency_window{20};
+  int consistency_min_tests{100};
+  double max_chi2_failure_fraction{0.5};
+  /// Ground-truth quaternion: |‖q‖ − 1| up to this is normalised, above it
+  /// the message is rejected.
+  double max_quat_norm_error{0.01};
+
+  /// Throws std::invalid_argument naming the bad option.
+  void validate() const;
+};
+
+/// `input` section of a vins / target_filter config.
+InputGuardOptions input_guard_options_from_config(const Config& cfg);
+
+/// Normalises a near-unit quaternion in place; false (with `why`) if it is
+/// non-finite or further than `max_norm_error` from unit norm.
+bool validate_quaternion(Eigen::Vector4d* q, double max_norm_error, std::string* why);
 
 struct VinsNodeOptions {
   estimator::VioOptions vio;
@@ -33,9 +76,14 @@ struct VinsNodeOptions {
   uint64_t perturb_seed{0};
   /// Publish the IMU-rate propagated state (VINS_STATE, updated = false).
   bool publish_imu_rate{true};
+  /// ... every this many IMU samples (>= 1). Each carries a full 15×15
+  /// covariance (≈ 2 kB) into every subscriber's socket; the camera-rate
+  /// consumers (scale_estimator, log evaluation) need only updated states.
+  int imu_rate_every{1};
   /// Frames queued while waiting for IMU beyond this many are processed
   /// anyway (IMU stream stalled) — bounded memory and latency.
   int max_queued_frames{5};
+  InputGuardOptions input;
 };
 
 /// The process's options from a vins config (config/vins.yaml, layout in
@@ -64,6 +112,9 @@ class VinsNode {
   bool initialized() const { return estimator_.initialized(); }
   int64_t frames_processed() const { return estimator_.frames_processed(); }
   int64_t resets() const { return resets_; }
+  /// Validates a ground-truth message in place (quaternions normalised);
+  /// false, said as dropped, if it is unusable.
+  bool check_ground_truth(GroundTruth* truth);
   const estimator::VioEstimator& estimator() const { return estimator_; }
   /// For attaching an estimator extension (VioEstimator::set_extension).
   estimator::VioEstimator& mutable_estimator() { return estimator_; }
@@ -74,6 +125,19 @@ class VinsNode {
   void publish_updated();
   void publish_propagated(int64_t utime);
   void say(NodeEvent::Kind kind, const std::string& message);
+  /// Runs `body`; an exception is said and resets the estimator, it never
+  /// leaves a callback.
+  template <typename F>
+  void guarded(const char* where, F&& body);
+  /// Drops the estimate (and, on a source reset, the IMU buffer, queued
+  /// frames and every stream clock) and says so; re-initialisation follows.
+  void reset_estimate(const std::string& why, bool clean_clock);
+  /// Applies a stream guard's verdict; false if the message is to be dropped.
+  bool admit(StreamGuard& guard, int64_t utime);
+  void on_imu_checked(const ImuData& imu);
+  void on_frame_checked(const CameraFrame& frame);
+  void check_consistency();
+  void initialise_from(const GroundTruth& truth);
 
   VinsNodeOptions options_;
   estimator::VioEstimator estimator_;
@@ -84,6 +148,15 @@ class VinsNode {
   std::deque<CameraFrame> queued_frames_;
   int64_t last_frame_utime_{-1};
   int64_t resets_{0};
+  StreamGuard imu_guard_;
+  StreamGuard frame_guard_;
+  int rejected_frames_{0};
+  int64_t imu_rate_count_{0};
+  struct GateCounts {
+    int tested{0};
+    int failed{0};
+  };
+  std::deque<GateCounts> gate_window_;
 };
 
 }  // namespace vimot

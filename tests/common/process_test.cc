@@ -64,20 +64,40 @@ TEST_CASE("heartbeat carries name and counters") {
     got = hb;
     received = true;
   });
+  const auto beat = [&] {
+    received = false;
+    p->publish_heartbeat();
+    while (p->lcm().handleTimeout(10) > 0) {
+    }
+    REQUIRE(received);
+  };
+  beat();
+  CHECK(got.name == "test-proc");
+  CHECK(got.status == "ok");
   p->report_dropped("test");
   p->set_counter("bytes_dropped", 5);
   p->set_counter("reconnects", 1);
   p->set_counter("bytes_dropped", 7);  // updated in place, order kept
+  beat();
+  CHECK(got.dropped == 1);
+  CHECK(got.messages_out == 0);  // the heartbeat itself is not counted
+  // Input not used as it came makes the output suspect (heartbeat_t.lcm).
+  CHECK(got.status == "degraded");
+  CHECK(got.counter_names == std::vector<std::string>({"bytes_dropped", "reconnects"}));
+  CHECK(got.counter_values == std::vector<int64_t>({7, 1}));
+}
+
+TEST_CASE("input lost on the way is counted with the dropped and degrades the status") {
+  auto p = make_process();
+  vimot::heartbeat_t got{};
+  p->subscribe<vimot::heartbeat_t>("HEARTBEAT", [&](const vimot::heartbeat_t& hb) { got = hb; });
+  p->report_lost(3, "3 IMU messages lost");
   p->publish_heartbeat();
   while (p->lcm().handleTimeout(10) > 0) {
   }
-  REQUIRE(received);
-  CHECK(got.name == "test-proc");
-  CHECK(got.dropped == 1);
-  CHECK(got.messages_out == 0);  // the heartbeat itself is not counted
-  CHECK(got.status == "ok");
-  CHECK(got.counter_names == std::vector<std::string>({"bytes_dropped", "reconnects"}));
-  CHECK(got.counter_values == std::vector<int64_t>({7, 1}));
+  CHECK(p->counters().lost == 3);
+  CHECK(got.dropped == 3);
+  CHECK(got.status == "degraded");
 }
 
 TEST_CASE("channels come from config; a missing required config is an error") {

@@ -25,9 +25,10 @@ struct Outputs {
   std::vector<NodeEvent> events;
 };
 
-Outputs run_node(const std::vector<sim::SimEvent>& events) {
+Outputs run_node(const std::vector<sim::SimEvent>& events, int imu_rate_every = 1) {
   VinsNodeOptions options;
   options.vio = estimator::load_vio_options(source_path("config/vins.yaml"));
+  options.imu_rate_every = imu_rate_every;
   Outputs out;
   VinsNode node(
       options,
@@ -161,4 +162,16 @@ TEST_CASE("vins node publishes IMU-rate predictions between updates and tracks t
   }
   // 10 s, 15 m of flight from a perturbed truth: centimetres, not metres.
   CHECK(worst < 0.1);
+}
+
+TEST_CASE("vins node thins the IMU-rate output without changing it", "[vins]") {
+  const std::vector<sim::SimEvent> events = simulate(5.0);
+  const Outputs full = run_node(events);
+  const Outputs thin = run_node(events, 10);
+  CHECK(same_states(full.updated, thin.updated));
+  REQUIRE(full.propagated.size() > 100);
+  REQUIRE(thin.propagated.size() == (full.propagated.size() + 9) / 10);
+  std::vector<NavState> every_tenth;
+  for (std::size_t i = 0; i < full.propagated.size(); i += 10) every_tenth.push_back(full.propagated[i]);
+  CHECK(same_states(every_tenth, thin.propagated));
 }

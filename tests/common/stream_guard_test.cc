@@ -1,0 +1,68 @@
+// StreamGuard: one bad timestamp is rejected without moving the clock, a
+// clock that really moved is a source reset after `reset_after` consistent
+// messages, and gaps against the expected period count lost messages.
+#include <catch2/catch.hpp>
+
+#include "common/process/stream_guard.h"
+
+using vimot::StreamGuard;
+using vimot::StreamGuardOptions;
+using vimot::StreamVerdict;
+
+namespace {
+StreamGuardOptions options() {
+  StreamGuardOptions o;
+  o.expected_period_s = 0.005;  // 200 Hz
+  o.max_forward_jump_s = 0.5;
+  o.max_backward_jump_s = 0.5;
+  o.reset_after = 3;
+  return o;
+}
+}  // namespace
+
+TEST_CASE("a single future or past timestamp is rejected, the clock stays") {
+  StreamGuard g("IMU", options());
+  CHECK(g.check(1'000'000).verdict == StreamVerdict::kAccept);
+  CHECK(g.check(1'005'000).verdict == StreamVerdict::kAccept);
+  CHECK(g.check(1'001'005'000).verdict == StreamVerdict::kRejectJump);  // +1000 s
+  CHECK(g.check(1'010'000).verdict == StreamVerdict::kAccept);
+  CHECK(g.check(10'000).verdict == StreamVerdict::kRejectJump);  // -1 s
+  const auto c = g.check(1'015'000);
+  CHECK(c.verdict == StreamVerdict::kAccept);
+  CHECK(c.lost == 0);
+  CHECK(g.rejected() == 2);
+  CHECK(g.source_resets() == 0);
+  // Slightly old or duplicate: the consumer's to drop, the clock unchanged.
+  CHECK(g.check(1'012'000).verdict == StreamVerdict::kAccept);
+  CHECK(g.check(1'020'000).lost == 0);
+}
+
+TEST_CASE("a clock that moved and stays there is a source reset") {
+  StreamGuard g("IMU", options());
+  g.check(10'000'000);
+  CHECK(g.check(5'000'000).verdict == StreamVerdict::kRejectJump);
+  CHECK(g.check(5'005'000).verdict == StreamVerdict::kRejectJump);
+  CHECK(g.check(5'010'000).verdict == StreamVerdict::kSourceReset);
+  CHECK(g.check(5'015'000).verdict == StreamVerdict::kAccept);
+  CHECK(g.source_resets() == 1);
+  // Inconsistent suspects (scattered garbage) never make a reset.
+  for (int i = 0; i < 10; ++i) {
+    CHECK(g.check(i % 2 ? 900'000'000 : 100'000'000 + i).verdict == StreamVerdict::kRejectJump);
+  }
+  CHECK(g.source_resets() == 1);
+}
+
+TEST_CASE("gaps count the messages lost against the expected period") {
+  StreamGuard g("IMU", options());
+  g.check(0);
+  CHECK(g.check(5'000).lost == 0);
+  CHECK(g.check(20'000).lost == 2);   // 10 and 15 ms missing
+  CHECK(g.check(26'000).lost == 0);   // jitter is not loss
+  CHECK(g.check(126'000).lost == 19);
+  CHECK(g.lost() == 21);
+  StreamGuardOptions unknown = options();
+  unknown.expected_period_s = 0.0;
+  StreamGuard u("FEATURES", unknown);
+  u.check(0);
+  CHECK(u.check(400'000).lost == 0);
+}
