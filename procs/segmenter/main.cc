@@ -4,7 +4,6 @@
 // per image on TARGET_MASK. All logic is in SegmenterNode /
 // common/segmentation; this file moves bytes.
 
-#include <stdexcept>
 #include <string>
 
 #include "common/process/image_conversion.h"
@@ -15,28 +14,6 @@
 #include "vimot/mask_t.hpp"
 
 namespace {
-
-vimot::mask_t to_mask_msg(int camera_id, int64_t utime, const cv::Mat& mask) {
-  vimot::mask_t msg;
-  msg.utime = utime;
-  msg.camera_id = static_cast<int8_t>(camera_id);
-  msg.width = mask.cols;
-  msg.height = mask.rows;
-  msg.data.assign(mask.datastart, mask.dataend);
-  msg.size = static_cast<int32_t>(msg.data.size());
-  return msg;
-}
-
-// A mask_t's pixels as a CV_8UC1 header on the message (no copy); a size
-// that does not match is reported like a wrong-size image.
-cv::Mat mask_from_msg(const vimot::mask_t& m) {
-  if (m.width < 1 || m.height < 1 || static_cast<int64_t>(m.width) * m.height != m.size ||
-      m.data.size() != static_cast<size_t>(m.size)) {
-    throw std::invalid_argument("mask_t " + std::to_string(m.width) + "x" + std::to_string(m.height) + " with " +
-                                std::to_string(m.size) + " bytes");
-  }
-  return cv::Mat(m.height, m.width, CV_8UC1, const_cast<uint8_t*>(m.data.data()));
-}
 
 int run(int argc, const char* const* argv) {
   vimot::Process process("segmenter",
@@ -51,7 +28,7 @@ int run(int argc, const char* const* argv) {
   vimot::SegmenterNode node(
       options,
       [&](int camera_id, int64_t utime, const cv::Mat& mask) {
-        process.publish(mask_channel, to_mask_msg(camera_id, utime, mask));
+        process.publish(mask_channel, vimot::to_lcm_mask(mask, utime, camera_id));
       },
       vimot::report_events_to(process));
 
@@ -59,7 +36,7 @@ int run(int argc, const char* const* argv) {
     process.subscribe<vimot::mask_t>(process.channel("target_mask_truth", "TARGET_MASK_TRUTH"),
                                      [&](const vimot::mask_t& m) {
                                        try {
-                                         node.on_true_mask(m.camera_id, m.utime, mask_from_msg(m));
+                                         node.on_true_mask(m.camera_id, m.utime, vimot::mask_from_lcm(m));
                                        } catch (const std::invalid_argument& e) {
                                          process.report_error(e.what());
                                        }
