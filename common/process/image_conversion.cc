@@ -45,4 +45,29 @@ cv::Mat grey_from_lcm_image(const image_t& msg) {
       .clone();
 }
 
+mask_t to_lcm_mask(const cv::Mat& mask, int64_t utime, int camera_id) {
+  if (mask.type() != CV_8UC1 || mask.empty()) {
+    throw std::invalid_argument("to_lcm_mask: expected a non-empty 8-bit single-channel mask");
+  }
+  const cv::Mat packed = mask.isContinuous() ? mask : mask.clone();
+  mask_t msg;
+  msg.utime = utime;
+  msg.camera_id = static_cast<int8_t>(camera_id);
+  msg.width = packed.cols;
+  msg.height = packed.rows;
+  msg.data.assign(packed.datastart, packed.dataend);
+  msg.size = static_cast<int32_t>(msg.data.size());
+  return msg;
+}
+
+cv::Mat mask_from_lcm(const mask_t& msg) {
+  if (msg.width <= 0 || msg.height <= 0 || static_cast<int64_t>(msg.width) * msg.height != msg.size ||
+      msg.data.size() != static_cast<std::size_t>(msg.size)) {
+    throw std::invalid_argument("mask_t at utime " + std::to_string(msg.utime) + ": " + std::to_string(msg.width) +
+                                "x" + std::to_string(msg.height) + " with size " + std::to_string(msg.size) +
+                                " and " + std::to_string(msg.data.size()) + " bytes");
+  }
+  return cv::Mat(msg.height, msg.width, CV_8UC1, const_cast<uint8_t*>(msg.data.data())).clone();
+}
+
 }  // namespace vimot

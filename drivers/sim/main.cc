@@ -12,23 +12,11 @@
 #include "common/sim/renderer.h"
 #include "common/sim/simulator.h"
 #include "common/process/image_conversion.h"
-#include "vimot/mask_t.hpp"
 #include "vimot/target_box_t.hpp"
 
 namespace {
 
 using vimot::log_info;
-
-vimot::mask_t to_mask_msg(const vimot::sim::RenderedView& view) {
-  vimot::mask_t msg;
-  msg.utime = view.utime;
-  msg.camera_id = static_cast<int8_t>(view.camera_id);
-  msg.width = view.mask.cols;
-  msg.height = view.mask.rows;
-  msg.data.assign(view.mask.datastart, view.mask.dataend);
-  msg.size = static_cast<int32_t>(msg.data.size());
-  return msg;
-}
 
 // The true box as a mask filter would report a perfect detection: raw =
 // filtered, no coasting, zero covariance and velocity.
@@ -101,7 +89,7 @@ int run(int argc, const char* const* argv) {
       if (renderer) {
         for (const vimot::sim::RenderedView& view : renderer->render(frame->utime)) {
           vimot::emit(*sink, camera_channels[view.camera_id], vimot::to_lcm_image(view.image, view.utime));
-          vimot::emit(*sink, mask_channel, to_mask_msg(view));
+          vimot::emit(*sink, mask_channel, vimot::to_lcm_mask(view.mask, view.utime, view.camera_id));
           vimot::emit(*sink, box_channel, to_box_msg(view));
           ++counts[3];
         }

@@ -67,3 +67,19 @@ TEST_CASE("malformed image_t messages are rejected with a reason", "[image]") {
   CHECK_THROWS_AS(vimot::to_lcm_image(cv::Mat(2, 2, CV_8UC3), 0), std::invalid_argument);
   CHECK_THROWS_AS(vimot::to_lcm_image(cv::Mat(), 0), std::invalid_argument);
 }
+
+TEST_CASE("a mask round-trips through mask_t; a malformed one is rejected", "[image]") {
+  const cv::Mat mask = ramp(3, 4);
+  const vimot::mask_t msg = vimot::to_lcm_mask(mask(cv::Rect(1, 0, 3, 3)), 5, 1);  // a non-continuous view
+  CHECK(msg.utime == 5);
+  CHECK(msg.camera_id == 1);
+  CHECK(msg.size == 9);
+  CHECK(cv::norm(vimot::mask_from_lcm(msg), mask(cv::Rect(1, 0, 3, 3)), cv::NORM_INF) == 0.0);
+  vimot::mask_t m = msg;
+  m.height = 4;  // 12 bytes promised, 9 carried
+  CHECK_THROWS_WITH(vimot::mask_from_lcm(m), Contains("3x4 with size 9"));
+  m = msg;
+  m.data.pop_back();
+  CHECK_THROWS_WITH(vimot::mask_from_lcm(m), Contains("8 bytes"));
+  CHECK_THROWS_AS(vimot::to_lcm_mask(cv::Mat(2, 2, CV_8UC3), 0, 0), std::invalid_argument);
+}

@@ -21,6 +21,7 @@
 #include "procs/feature_tracker/feature_tracker_node.h"
 #include "procs/mask_filter/mask_filter_node.h"
 #include "procs/scale_estimator/scale_node.h"
+#include "procs/segmenter/segmenter_node.h"
 #include "procs/target_filter/target_filter_node.h"
 #include "procs/vins/vins_node.h"
 
@@ -49,6 +50,10 @@ void load_with_its_reader(const std::string& name, const std::string& path) {
     CHECK(object_tracker_options_from_config(cfg).window_size == 20);
   } else if (name == "scale_estimator.yaml") {
     CHECK(scale_node_options_from_config(cfg).max_pending == 60);
+  } else if (name == "segmenter.yaml") {
+    const SegmenterNodeOptions o = SegmenterNodeOptions::from_config(cfg);
+    CHECK(o.backend == SegmenterNodeOptions::Backend::kOnnx);
+    CHECK(o.onnx.model_file == source_path("config/models/segmenter_unet.onnx"));
   } else if (name == "target_filter.yaml") {
     const TargetFilterNodeOptions o = node_options_from_config(cfg);
     CHECK(o.target_enabled);
