@@ -8,6 +8,8 @@
 # with vimot-sheriff and prints a summary: processes, messages per channel,
 # the accuracy of the LCM run against ground truth, the same scenario run
 # offline (in-process, same libraries) for comparison, and the log path.
+# Exits 4 if the LCM run's VIO figures differ from the offline run's (a
+# relative difference above 1e-6: input lost or late under load).
 #  - default: sheriff_configs/sim_demo.pmd (simulator, vins, the target
 #    filter, lcm-logger): VIO and target accuracy.
 #  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
@@ -105,8 +107,21 @@ fi
 "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
   --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
   --perturb-seed "${perturb_seed:-0}" "${offline_args[@]}" --out "$out/offline" --quiet > "$out/offline.txt" 2>&1 || true
+# Every LCM figure must equal the offline one: a difference (lost or late
+# messages) makes the demo fail, naming the figure, at its end.
+lcm_vs_offline=0
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --json "$out/lcm_summary.json" \
-  --compare "$out/offline/summary.json" | sed 's/^/   /'
+  --compare "$out/offline/summary.json" --tolerance 1e-6 > "$out/lcm_vs_offline.txt" 2>&1 || lcm_vs_offline=$?
+sed 's/^/   /' "$out/lcm_vs_offline.txt"
+finish() {
+  if [ "$lcm_vs_offline" -ne 0 ]; then
+    echo "demo: the LCM run differs from the offline run of the same seed (vimot-log-eval exit $lcm_vs_offline):" >&2
+    grep -E 'tolerance|error' "$out/lcm_vs_offline.txt" | sed 's/^/   /' >&2 || true
+    echo "   messages were lost or processed late; see the heartbeats' dropped counts in $out/sheriff.txt" >&2
+    exit 4
+  fi
+  exit 0
+}
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
 if [ $pipeline = pixels ]; then
   echo "== the same seed at feature level (the simulator's own tracks, no pixels), offline:"
@@ -115,7 +130,7 @@ if [ $pipeline = pixels ]; then
     --duration "$VIMOT_DURATION" --perturb-seed "${perturb_seed:-0}" --quiet > "$out/offline_features.txt" 2>&1 || true
   grep -E '^(seed|mean|pred)' "$out/offline_features.txt" | sed 's/^/   /'
   echo "== log (images left out): $VIMOT_LOG"
-  exit 0
+  finish
 fi
 if [ $pipeline = mono ]; then
   echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run:"
@@ -128,7 +143,7 @@ if [ $pipeline = mono ]; then
   echo "   (offline run: $out/offline_scale.txt)"
   echo "== log: $VIMOT_LOG"
   echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
-  exit 0
+  finish
 fi
 echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal VINS_STATE):"
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE \
@@ -149,3 +164,4 @@ if sed -n '/^  init:/,/^  [a-z_]*:/p' "$target_cfg" | grep -q '^    mode: *featu
 echo "   (offline target run: $out/offline_target.txt)"
 echo "== log: $VIMOT_LOG"
 echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
+finish
