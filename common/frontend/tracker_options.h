@@ -38,6 +38,13 @@ struct StaticTrackOptions {
   // Frame-to-frame KLT alone drifts as the patch deforms (docs).
   int corner_refine_px{0};
   double corner_refine_max_shift_px{1.0};  // a point the refinement moves further is dropped
+  // A static track older than this many frames is ended (its point is
+  // re-detected under a new id): KLT's error grows with a track's age
+  // (docs/feature_tracker.md). 0 = no limit.
+  int max_track_frames{0};
+  /// Static features keep this far (px) from the target box: a KLT window
+  /// overlapping the target follows the target's motion, not the room's.
+  int box_margin_px() const { return klt_window_px / 2; }
   void validate() const;
 };
 
