@@ -43,34 +43,6 @@ void check_box(const std::optional<Box>& box, const std::string& name) {
   }
 }
 
-// Re-centres each point with `keep[i]` set on the image's corner near it
-// (cv::cornerSubPix); a point moved more than max_shift is not a corner
-// and loses `keep`. The corner is where the scene's edges meet, so a track
-// re-centred every frame does not accumulate KLT's drift.
-void refine_corners(const cv::Mat& image, const StaticTrackOptions& o, std::vector<cv::Point2f>* points,
-                    std::vector<uint8_t>* keep) {
-  if (o.corner_refine_px <= 0) return;
-  std::vector<cv::Point2f> refined;
-  std::vector<std::size_t> index;
-  for (std::size_t i = 0; i < points->size(); ++i) {
-    if (!(*keep)[i]) continue;
-    refined.push_back((*points)[i]);
-    index.push_back(i);
-  }
-  if (refined.empty()) return;
-  cv::cornerSubPix(image, refined, cv::Size(o.corner_refine_px, o.corner_refine_px), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.01));
-  const double max2 = o.corner_refine_max_shift_px * o.corner_refine_max_shift_px;
-  for (std::size_t k = 0; k < refined.size(); ++k) {
-    const cv::Point2f d = refined[k] - (*points)[index[k]];
-    if (d.dot(d) > max2) {
-      (*keep)[index[k]] = 0;
-    } else {
-      (*points)[index[k]] = refined[k];
-    }
-  }
-}
-
 }  // namespace
 
 FeatureTracker::FeatureTracker(const FeatureTrackerOptions& options, const std::vector<CameraCalibration>& cameras)
@@ -144,7 +116,6 @@ std::vector<FeatureTracker::Point> FeatureTracker::klt(const std::vector<cv::Mat
       from_pyr, to_pyr, from, to, status, error, cv::Size(o.klt_window_px, o.klt_window_px), o.klt_pyramid_levels,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations, o.klt_epsilon),
       cv::OPTFLOW_USE_INITIAL_FLOW);
-  refine_corners(to_pyr[0], o, &to, &status);
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!status[i] || !usable(to_cam, to[i], to_box)) continue;
     Point p;
@@ -186,12 +157,7 @@ void FeatureTracker::detect_static(const std::optional<Box>& box) {
   std::vector<cv::Point2f> existing;
   existing.reserve(left.size());
   for (const Point& p : left) existing.push_back(p.pixel);
-  std::vector<cv::Point2f> corners = detect_grid_fast(pyramid_[0][0], existing, box, options_.static_tracks);
-  std::vector<uint8_t> keep(corners.size(), 1);
-  refine_corners(pyramid_[0][0], options_.static_tracks, &corners, &keep);
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    if (!keep[i] || !usable(0, corners[i], box)) continue;
-    const cv::Point2f& px = corners[i];
+  for (const cv::Point2f& px : detect_grid_fast(pyramid_[0][0], existing, box, options_.static_tracks)) {
     Point p;
     p.pixel = px;
     if (!normalize(0, &p)) continue;

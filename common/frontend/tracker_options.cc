@@ -43,9 +43,6 @@ void StaticTrackOptions::validate() const {
   require(klt_pyramid_levels >= 0 && klt_pyramid_levels <= 8, "static.klt_pyramid_levels must be in 0..8");
   require(klt_max_iterations > 0, "static.klt_max_iterations must be > 0");
   require(klt_epsilon > 0.0, "static.klt_epsilon must be > 0");
-  require(corner_refine_px >= 0 && corner_refine_px < klt_window_px,
-          "static.corner_refine_px must be in [0, klt_window_px)");
-  require(corner_refine_max_shift_px > 0.0, "static.corner_refine_max_shift_px must be > 0");
   require(max_track_frames >= 0, "static.max_track_frames must be >= 0");
 }
 
@@ -82,7 +79,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   only_keys(cfg, s + "static",
             {"equalize", "num_features", "grid_cols", "grid_rows", "fast_threshold", "min_distance_px", "border_px",
              "klt_window_px", "klt_pyramid_levels", "klt_max_iterations", "klt_epsilon",
-             "corner_refine_px", "corner_refine_max_shift_px", "max_track_frames"});
+             "max_track_frames"});
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
              "max_motion_px", "loop_closure_max_hamming", "max_stored_points"});
@@ -100,8 +97,6 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "static.klt_pyramid_levels", &st.klt_pyramid_levels);
   read(cfg, s + "static.klt_max_iterations", &st.klt_max_iterations);
   read(cfg, s + "static.klt_epsilon", &st.klt_epsilon);
-  read(cfg, s + "static.corner_refine_px", &st.corner_refine_px);
-  read(cfg, s + "static.corner_refine_max_shift_px", &st.corner_refine_max_shift_px);
   read(cfg, s + "static.max_track_frames", &st.max_track_frames);
 
   TargetTrackOptions& t = o.target;

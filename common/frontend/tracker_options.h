@@ -33,11 +33,6 @@ struct StaticTrackOptions {
   int klt_pyramid_levels{3};   // levels above the full image
   int klt_max_iterations{20};
   double klt_epsilon{0.03};  // px, KLT stop criterion
-  // Half-side (px) of the window in which each new corner and each KLT
-  // result is re-centred on the image's corner (cv::cornerSubPix); 0 = off.
-  // Frame-to-frame KLT alone drifts as the patch deforms (docs).
-  int corner_refine_px{0};
-  double corner_refine_max_shift_px{1.0};  // a point the refinement moves further is dropped
   // A static track older than this many frames is ended (its point is
   // re-detected under a new id): KLT's error grows with a track's age
   // (docs/feature_tracker.md). 0 = no limit.

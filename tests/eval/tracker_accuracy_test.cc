@@ -61,13 +61,16 @@ TEST_CASE("Renderer::surface_at agrees with the rendered mask", "[eval][tracker_
 
 TEST_CASE("Static tracks on rendered pairs stay within the estimator's pixel noise", "[eval][tracker_accuracy]") {
   const sim::Simulator sim(paper_config(3.0));
-  eval::PixelFrontEnd front(sim, tracker_options());
+  const frontend::FeatureTrackerOptions options = tracker_options();
+  REQUIRE(options.static_tracks.max_track_frames > 0);
+  eval::PixelFrontEnd front(sim, options);
   const std::vector<eval::ObservationError> all = eval::tracker_errors(sim, &front, sim.camera_frame_count());
   std::vector<eval::ObservationError> statics, stereo_new;
   for (const eval::ObservationError& e : all) {
     if (e.is_target) continue;
     // A static feature never starts on the target (the box and its margin).
     CHECK_FALSE(e.born_on_target);
+    CHECK(e.age < options.static_tracks.max_track_frames);
     statics.push_back(e);
     if (e.camera_id == 1 && e.age == 0) stereo_new.push_back(e);
   }
