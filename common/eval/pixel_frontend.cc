@@ -9,7 +9,8 @@ PixelFrontEnd::PixelFrontEnd(const sim::Simulator& sim, const frontend::FeatureT
     : renderer_(sim), tracker_(options, sim.cameras()) {}
 
 CameraFrame PixelFrontEnd::frame(int64_t utime) {
-  const std::vector<sim::RenderedView> views = renderer_.render(utime);
+  views_ = renderer_.render(utime);
+  const std::vector<sim::RenderedView>& views = views_;
   // A box only where the target is visible: the feature tracker node takes
   // TARGET_BOX_TRUTH's filtered box only when filtered_valid (= visible).
   auto box_of = [&views](std::size_t cam) -> std::optional<frontend::Box> {

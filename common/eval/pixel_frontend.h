@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "common/frontend/feature_tracker.h"
 #include "common/frontend/tracker_options.h"
@@ -28,10 +29,14 @@ class PixelFrontEnd {
   CameraFrame frame(int64_t utime);
 
   const frontend::FeatureTracker& tracker() const { return tracker_; }
+  const sim::Renderer& renderer() const { return renderer_; }
+  /// The rendered views of the last frame() (truth: masks, boxes).
+  const std::vector<sim::RenderedView>& last_views() const { return views_; }
 
  private:
   sim::Renderer renderer_;
   frontend::FeatureTracker tracker_;
+  std::vector<sim::RenderedView> views_;
 };
 
 }  // namespace eval

@@ -96,7 +96,7 @@ bool FeatureTracker::normalize(int cam, Point* p) const {
 bool FeatureTracker::usable(int cam, const cv::Point2f& px, const std::optional<Box>& box) const {
   const double border = options_.static_tracks.border_px;
   if (!cameras_[static_cast<std::size_t>(cam)].in_image(Eigen::Vector2d(px.x, px.y), border)) return false;
-  return !(box && box->contains(px.x, px.y));
+  return !(box && box->contains(px.x, px.y, options_.static_tracks.box_margin_px()));
 }
 
 std::vector<FeatureTracker::Point> FeatureTracker::klt(const std::vector<cv::Mat>& from_pyr, int to_cam,
@@ -121,6 +121,7 @@ std::vector<FeatureTracker::Point> FeatureTracker::klt(const std::vector<cv::Mat
     Point p;
     p.id = points[i].id;
     p.pixel = to[i];
+    p.born_frame = points[i].born_frame;
     if (normalize(to_cam, &p)) out.push_back(p);
   }
   return out;
@@ -132,6 +133,12 @@ void FeatureTracker::track_static_temporal(int cam, const std::optional<Box>& bo
   std::unordered_map<int64_t, Eigen::Vector2d> before;
   for (const Point& p : static_[c]) before.emplace(p.id, p.normalized);
   std::vector<Point> tracked = klt(prev_pyramid_[c], cam, pyramid_[c], static_[c], box);
+  const int max_age = options_.static_tracks.max_track_frames;
+  if (max_age > 0) {
+    tracked.erase(std::remove_if(tracked.begin(), tracked.end(),
+                                 [&](const Point& p) { return frame_index_ - p.born_frame >= max_age; }),
+                  tracked.end());
+  }
   std::vector<Eigen::Vector2d> a, b;
   for (const Point& p : tracked) {
     a.push_back(before.at(p.id));
@@ -155,6 +162,7 @@ void FeatureTracker::detect_static(const std::optional<Box>& box) {
     p.pixel = px;
     if (!normalize(0, &p)) continue;
     p.id = next_id_++;
+    p.born_frame = frame_index_;
     left.push_back(p);
   }
 }

@@ -69,6 +69,7 @@ class FeatureTracker {
     int64_t id{-1};
     cv::Point2f pixel;
     Eigen::Vector2d normalized{Eigen::Vector2d::Zero()};
+    int64_t born_frame{0};  // frame index of the track's first corner
   };
   struct TargetPoint {
     Point point;

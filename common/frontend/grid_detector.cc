@@ -24,7 +24,7 @@ std::vector<cv::Point2f> detect_grid_fast(const cv::Mat& image, const std::vecto
     return cy * o.grid_cols + cx;
   };
 
-  // Forbidden pixels: near a tracked point, and the target box.
+  // Forbidden pixels: near a tracked point, and the target box with its margin.
   cv::Mat free_mask(image.size(), CV_8UC1, cv::Scalar(255));
   const int radius = static_cast<int>(std::lround(o.min_distance_px));
   std::vector<int> count(static_cast<std::size_t>(cells), 0);
@@ -33,8 +33,10 @@ std::vector<cv::Point2f> detect_grid_fast(const cv::Mat& image, const std::vecto
     if (radius > 0) cv::circle(free_mask, p, radius, cv::Scalar(0), cv::FILLED);
   }
   if (box) {
-    const cv::Rect r(static_cast<int>(std::floor(box->x_min)), static_cast<int>(std::floor(box->y_min)),
-                     static_cast<int>(std::ceil(box->width)) + 2, static_cast<int>(std::ceil(box->height)) + 2);
+    const int m = o.box_margin_px();
+    const cv::Rect r(static_cast<int>(std::floor(box->x_min)) - m, static_cast<int>(std::floor(box->y_min)) - m,
+                     static_cast<int>(std::ceil(box->width)) + 2 + 2 * m,
+                     static_cast<int>(std::ceil(box->height)) + 2 + 2 * m);
     cv::rectangle(free_mask, r & cv::Rect(0, 0, image.cols, image.rows), cv::Scalar(0), cv::FILLED);
   }
 

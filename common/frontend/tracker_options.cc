@@ -43,6 +43,7 @@ void StaticTrackOptions::validate() const {
   require(klt_pyramid_levels >= 0 && klt_pyramid_levels <= 8, "static.klt_pyramid_levels must be in 0..8");
   require(klt_max_iterations > 0, "static.klt_max_iterations must be > 0");
   require(klt_epsilon > 0.0, "static.klt_epsilon must be > 0");
+  require(max_track_frames >= 0, "static.max_track_frames must be >= 0");
 }
 
 void TargetTrackOptions::validate() const {
@@ -77,7 +78,8 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   if (!section.empty()) only_keys(cfg, section, {"static", "target", "ransac"});
   only_keys(cfg, s + "static",
             {"equalize", "num_features", "grid_cols", "grid_rows", "fast_threshold", "min_distance_px", "border_px",
-             "klt_window_px", "klt_pyramid_levels", "klt_max_iterations", "klt_epsilon"});
+             "klt_window_px", "klt_pyramid_levels", "klt_max_iterations", "klt_epsilon",
+             "max_track_frames"});
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
              "max_motion_px", "loop_closure_max_hamming", "max_stored_points"});
@@ -95,6 +97,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "static.klt_pyramid_levels", &st.klt_pyramid_levels);
   read(cfg, s + "static.klt_max_iterations", &st.klt_max_iterations);
   read(cfg, s + "static.klt_epsilon", &st.klt_epsilon);
+  read(cfg, s + "static.max_track_frames", &st.max_track_frames);
 
   TargetTrackOptions& t = o.target;
   read(cfg, s + "target.num_features", &t.num_features);

@@ -33,6 +33,13 @@ struct StaticTrackOptions {
   int klt_pyramid_levels{3};   // levels above the full image
   int klt_max_iterations{20};
   double klt_epsilon{0.03};  // px, KLT stop criterion
+  // A static track older than this many frames is ended (its point is
+  // re-detected under a new id): KLT's error grows with a track's age
+  // (docs/feature_tracker.md). 0 = no limit.
+  int max_track_frames{0};
+  /// Static features keep this far (px) from the target box: a KLT window
+  /// overlapping the target follows the target's motion, not the room's.
+  int box_margin_px() const { return klt_window_px / 2; }
   void validate() const;
 };
 

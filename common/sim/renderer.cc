@@ -275,6 +275,51 @@ std::vector<RenderedView> Renderer::render(int64_t utime) const {
   return views;
 }
 
+Renderer::SurfaceHit Renderer::surface_at(int cam, int64_t utime, const Eigen::Vector2d& pixel) const {
+  if (cam < 0 || cam >= static_cast<int>(cameras_.size())) {
+    throw std::invalid_argument("Renderer::surface_at: no camera " + std::to_string(cam));
+  }
+  if (utime < sim_.start_utime() || utime > sim_.end_utime()) {
+    throw std::invalid_argument("Renderer::surface_at: utime " + std::to_string(utime) + " outside the run");
+  }
+  const double t = sim_.sim_time(utime);
+  const CameraCalibration& calib = sim_.cameras()[static_cast<std::size_t>(cam)];
+  const Eigen::Matrix4d T_ItoG = pose_of(sim_.robot_state(t));
+  const Eigen::Matrix3d R_CtoG = T_ItoG.topLeftCorner<3, 3>() * calib.R_ItoC.transpose();
+  const Eigen::Vector3d o = camera_centre(T_ItoG, calib);
+  const Eigen::Vector2d n = sim_.camera_models()[static_cast<std::size_t>(cam)].undistort(pixel);
+  const Eigen::Vector3d d = R_CtoG * Eigen::Vector3d(n.x(), n.y(), 1.0);
+  // The room seen from inside: the nearest wall the ray leaves through.
+  double t_hit = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    if (d(k) != 0.0) t_hit = std::min(t_hit, ((d(k) > 0.0 ? room_.max()(k) : room_.min()(k)) - o(k)) / d(k));
+  }
+  SurfaceHit hit;
+  const std::optional<SplineState> target = sim_.target_state(t);
+  if (target) {
+    // Slab test in the target's frame.
+    const Eigen::Vector3d o_T = target->R_BtoG.transpose() * (o - target->p_BinG);
+    const Eigen::Vector3d d_T = target->R_BtoG.transpose() * d;
+    double t_in = 0.0, t_out = t_hit;
+    for (int k = 0; k < 3; ++k) {
+      if (d_T(k) == 0.0) {
+        if (std::abs(o_T(k)) > target_half_(k)) t_in = t_out + 1.0;
+        continue;
+      }
+      double t1 = (-target_half_(k) - o_T(k)) / d_T(k), t2 = (target_half_(k) - o_T(k)) / d_T(k);
+      if (t1 > t2) std::swap(t1, t2);
+      t_in = std::max(t_in, t1);
+      t_out = std::min(t_out, t2);
+    }
+    if (t_in <= t_out && t_in > 0.0) {
+      t_hit = t_in;
+      hit.on_target = true;
+    }
+  }
+  hit.p_inG = o + t_hit * d;
+  return hit;
+}
+
 RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix4d& T_ItoG,
                                      const Eigen::Matrix4d* T_TtoG, double gain) const {
   const CameraCalibration& calib = sim_.cameras()[static_cast<std::size_t>(cam)];

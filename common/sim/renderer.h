@@ -72,6 +72,18 @@ class Renderer {
   /// lie in [sim.start_utime(), sim.end_utime()] (std::invalid_argument).
   std::vector<RenderedView> render(int64_t utime) const;
 
+  /// What pixel `pixel` (raw, distorted; pixel centres at integer
+  /// coordinates, as rendered) of camera `cam` sees at `utime`: the nearest
+  /// surface along its ray, in double precision — the geometry the image
+  /// shows, for checking a tracker against truth. std::invalid_argument for
+  /// a bad camera or utime, std::runtime_error for a pixel that cannot be
+  /// undistorted.
+  struct SurfaceHit {
+    Eigen::Vector3d p_inG{Eigen::Vector3d::Zero()};  // the hit point (m)
+    bool on_target{false};                           // the target, not the room
+  };
+  SurfaceHit surface_at(int cam, int64_t utime, const Eigen::Vector2d& pixel) const;
+
   /// The room's bounds in G (m).
   const Eigen::AlignedBox3d& room() const { return room_; }
 

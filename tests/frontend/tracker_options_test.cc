@@ -38,9 +38,12 @@ TEST_CASE("config/feature_tracker.yaml gives the built-in defaults") {
 TEST_CASE("tracker options: values are read, unknown keys and bad values refused") {
   const FeatureTrackerOptions o = FeatureTrackerOptions::from_config(
       Config::from_string(
-          "tracker:\n  static: {num_features: 120, klt_window_px: 11}\n  ransac: {threshold_px: 0.5}\n"),
+          "tracker:\n  static: {num_features: 120, klt_window_px: 11, max_track_frames: 20}\n"
+          "  ransac: {threshold_px: 0.5}\n"),
       "tracker");
   CHECK(o.static_tracks.num_features == 120);
+  CHECK(o.static_tracks.max_track_frames == 20);
+  CHECK(o.static_tracks.box_margin_px() == 5);
   CHECK(o.static_tracks.klt_window_px == 11);
   CHECK(o.ransac.threshold_px == 0.5);
   CHECK_THAT(error_of("tracker:\n  static: {num_feature: 120}\n"), Catch::Contains("tracker.static.num_feature") &&
@@ -49,5 +52,6 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   CHECK_THAT(error_of("tracker:\n  stereo: {}\n"), Catch::Contains("tracker.stereo") && Catch::Contains("unknown"));
   CHECK_THAT(error_of("tracker:\n  static: {klt_window_px: 14}\n"), Catch::Contains("klt_window_px"));
   CHECK_THAT(error_of("tracker:\n  ransac: {min_points: 7}\n"), Catch::Contains("min_points"));
+  CHECK_THAT(error_of("tracker:\n  static: {max_track_frames: -1}\n"), Catch::Contains("max_track_frames"));
   CHECK_THAT(error_of("tracker:\n  target: {match_ratio: 1.5}\n"), Catch::Contains("match_ratio"));
 }
