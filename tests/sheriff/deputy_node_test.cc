@@ -154,7 +154,13 @@ TEST_CASE("deputy reports memory and CPU of a running command") {
   Link link;
   link.sheriff.Start("talker");
   REQUIRE(link.Until([&] { return link.Status("talker") == CommandStatus::kRunning; }));
-  const DeputyInfo info = link.deputy.Info(Now());
+  // Running from the fork on; while the wrapper execs the program the
+  // kernel reports no resident pages for a moment: wait for the program.
+  DeputyInfo info;
+  CHECK(link.Until([&] {
+    info = link.deputy.Info(Now());
+    return !info.cmds.empty() && info.cmds.at(0).mem_rss_bytes > 0;
+  }));
   CHECK(info.host == "vehicle");
   CHECK(info.phys_mem_total_bytes > 0);
   CHECK(info.phys_mem_free_bytes <= info.phys_mem_total_bytes);
