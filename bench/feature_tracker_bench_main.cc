@@ -25,16 +25,11 @@
 #include "common/frontend/feature_tracker.h"
 #include "common/frontend/tracking_stats.h"
 #include "common/process/arg_parser.h"
+#include "common/time/utime.h"
 
 namespace {
 
 using namespace vimot;
-
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Summary {
   double mean, median, p95, max;

@@ -24,16 +24,11 @@
 #include "common/sim/renderer.h"
 #include "common/sim/sim_config.h"
 #include "common/sim/simulator.h"
+#include "common/time/utime.h"
 
 namespace {
 
 using namespace vimot;
-
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
 
 void print_times(const char* what, std::vector<double> cpu, std::vector<double> wall) {
   for (std::vector<double>* v : {&cpu, &wall}) std::sort(v->begin(), v->end());

@@ -15,16 +15,11 @@
 #include "common/process/arg_parser.h"
 #include "drivers/imu_mip/mip_messages.h"
 #include "drivers/imu_mip/mip_parser.h"
+#include "common/time/utime.h"
 
 namespace {
 
 using namespace vimot;
-
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Result {
   double seconds{0.0};
@@ -37,7 +32,7 @@ Result run(const std::vector<uint8_t>& bytes, std::size_t chunk, int repeat) {
   Result r;
   mip::MipPacket packet;
   mip::MipImuSample sample;
-  const double start = thread_cpu_seconds();
+  const double start = 1e-3 * thread_cpu_ms();
   for (int i = 0; i < repeat; ++i) {
     mip::MipParser parser;
     for (std::size_t pos = 0; pos < bytes.size(); pos += chunk) {
@@ -49,7 +44,7 @@ Result run(const std::vector<uint8_t>& bytes, std::size_t chunk, int repeat) {
     r.packets += parser.counters().packets;
     r.bytes_dropped += parser.counters().bytes_dropped;
   }
-  r.seconds = thread_cpu_seconds() - start;
+  r.seconds = 1e-3 * thread_cpu_ms() - start;
   return r;
 }
 

@@ -21,29 +21,11 @@
 #include "common/process/arg_parser.h"
 #include "common/sim/renderer.h"
 #include "common/sim/sim_config.h"
+#include "common/time/utime.h"
 
 namespace {
 
 using namespace vimot;
-
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t comma = list.find(',', start);
-    const std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (!item.empty()) out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
 
 int run(int argc, const char* const* argv) {
   ArgParser args("vimot-bench-render",
@@ -68,7 +50,7 @@ int run(int argc, const char* const* argv) {
   std::printf("%-10s %4s %9s %8s | %7s %7s %7s %7s | %6s %6s\n", "scenario", "cams", "size", "setup s", "mean",
               "median", "p95", "max", "FAST", "target");
   std::printf("%-10s %4s %9s %8s | %31s | %13s\n", "", "", "", "", "CPU ms per frame", "per image");
-  for (const std::string& file : split(args.get("configs"))) {
+  for (const std::string& file : split_comma_list(args.get("configs"))) {
     sim::SimConfig config = sim::from_config(Config::load_file(file));
     config.seed = static_cast<uint64_t>(args.get_int("seed"));
     const sim::Simulator sim(config);

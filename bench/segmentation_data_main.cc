@@ -12,19 +12,6 @@ namespace {
 
 using namespace vimot;
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t comma = list.find(',', start);
-    const std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (!item.empty()) out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 int run(int argc, const char* const* argv) {
   ArgParser args("vimot-segmentation-data",
                  "Writes rendered grey images and their exact target masks (PNG pairs img_N.png,\n"
@@ -41,7 +28,7 @@ int run(int argc, const char* const* argv) {
   if (!args.parse(argc, argv)) return 0;
   if (!args.given("out")) throw ArgError("--out DIR is required");
   segmentation::SegmentationDataOptions o;
-  o.sim_configs = split(args.get("configs"));
+  o.sim_configs = split_comma_list(args.get("configs"));
   o.runs = static_cast<int>(args.get_int("runs"));
   o.frames_per_run = static_cast<int>(args.get_int("frames"));
   o.seed = static_cast<uint64_t>(args.get_int("seed"));

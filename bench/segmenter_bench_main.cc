@@ -18,16 +18,11 @@
 #include "common/segmentation/segmenter.h"
 #include "common/sim/renderer.h"
 #include "common/sim/sim_config.h"
+#include "common/time/utime.h"
 
 namespace {
 
 using namespace vimot;
-
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
 
 int run(int argc, const char* const* argv) {
   ArgParser args("vimot-bench-segmenter",

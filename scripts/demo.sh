@@ -8,8 +8,8 @@
 # with vimot-sheriff and prints a summary: processes, messages per channel,
 # the accuracy of the LCM run against ground truth, the same scenario run
 # offline (in-process, same libraries) for comparison, and the log path.
-# Exits 4 if the LCM run's VIO figures differ from the offline run's (a
-# relative difference above 1e-6: input lost or late under load).
+# Exits 4 if the LCM run's VIO or target figures differ from the offline
+# run's (a relative difference above 1e-6: input lost or late under load).
 #  - default: sheriff_configs/sim_demo.pmd (simulator, vins, the target
 #    filter, lcm-logger): VIO and target accuracy.
 #  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
@@ -159,8 +159,15 @@ if sed -n '/^  init:/,/^  [a-z_]*:/p' "$target_cfg" | grep -q '^    mode: *featu
   --modes "$(target_key mode)" --representations "$(target_key representation)" \
   --sigmas "$(target_key sigma_t)" --no-vio-only --runs 1 --first-seed "$VIMOT_SEED" \
   --perturb-seed "${perturb_seed:-0}" --out "$out/offline_target" --quiet > "$out/offline_target.txt" 2>&1 || true
+target_status=0
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE $own_frame \
-  --compare-target "$out/offline_target/summary.json" | grep -E '^(target|compare|  target)' | sed 's/^/   /'
+  --compare-target "$out/offline_target/summary.json" --tolerance 1e-6 > "$out/lcm_vs_offline_target.txt" 2>&1 \
+  || target_status=$?
+grep -E '^(target|compare|  target)' "$out/lcm_vs_offline_target.txt" | sed 's/^/   /' || true
+if [ "$target_status" -ne 0 ] && [ "$lcm_vs_offline" -eq 0 ]; then
+  lcm_vs_offline=$target_status
+  cat "$out/lcm_vs_offline_target.txt" >> "$out/lcm_vs_offline.txt"
+fi
 echo "   (offline target run: $out/offline_target.txt)"
 echo "== log: $VIMOT_LOG"
 echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"

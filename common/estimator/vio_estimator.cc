@@ -11,6 +11,7 @@
 #include "common/config/config.h"
 #include "common/estimator/state_helper.h"
 #include "common/math/quat.h"
+#include "common/time/utime.h"
 
 namespace vimot {
 namespace estimator {
@@ -21,13 +22,6 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-// CPU time of the calling thread, ms.
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
 }
 
 template <typename T>

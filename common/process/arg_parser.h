@@ -14,6 +14,9 @@ class ArgError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The non-empty items of a comma-separated option value ("a,b,,c" -> a b c).
+std::vector<std::string> split_comma_list(const std::string& list);
+
 class ArgParser {
  public:
   ArgParser(std::string program, std::string summary);

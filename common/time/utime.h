@@ -22,4 +22,8 @@ inline double utime_to_seconds(int64_t utime) {
 /// Wall-clock time now, in microseconds since the epoch (monitoring only).
 int64_t wall_clock_utime();
 
+/// CPU time of the calling thread, ms (per-frame cost figures: unlike wall
+/// time it does not count waiting for a core on a loaded machine).
+double thread_cpu_ms();
+
 }  // namespace vimot
