@@ -17,6 +17,7 @@
 #include "common/eval/target_eval.h"
 #include "common/object/object_tracker.h"
 #include "common/sim/sim_config.h"
+#include "drivers/camera/camera_config.h"
 #include "drivers/imu_mip/imu_mip_config.h"
 #include "procs/feature_tracker/feature_tracker_node.h"
 #include "procs/mask_filter/mask_filter_node.h"
@@ -34,7 +35,10 @@ std::string source_path(const std::string& relative) { return std::string(VIMOT_
 // The reader of each kind of shipped config, by file name prefix.
 void load_with_its_reader(const std::string& name, const std::string& path) {
   const Config cfg = Config::load_file(path);
-  if (name == "euroc_stereo.yaml") {
+  if (name == "camera.yaml") {
+    const camera::CameraConfig c = camera::camera_config_from(cfg);
+    CHECK(c.sources.size() == (c.driver.stereo ? 2u : 1u));
+  } else if (name == "euroc_stereo.yaml") {
     const estimator::VioOptions o = estimator::VioOptions::from_config(cfg);
     CHECK(o.cameras.size() == 2);
   } else if (name.rfind("feature_tracker", 0) == 0) {
@@ -156,6 +160,8 @@ TEST_CASE("misspelt keys, unknown sections and bad values name file, key path an
       {target + "\nestimator: {num_clones: 3}\n", read_target, "key 'estimator' (value '{num_clones: 3}')"},
       {"scenario: paper\ncalibration_file: euroc_stereo.yaml\ncamera: {rate_hz: 20, rate_hz: 10}\n",
        [](const Config& c) { sim::from_config(c); }, "key 'camera.rate_hz' is repeated (line 3, value '10')"},
+      {"mode: mono\nsources: {left: a.avi}\nimage: {width: 64, height: 48, fsp: 20}\n",
+       [](const Config& c) { camera::camera_config_from(c); }, "key 'image.fsp' (value '20') is unknown"},
       {"object_tracker: {window_size: 20}\nchannels: {}\nobjekt_filter: {}\n",
        [](const Config& c) { object_tracker_options_from_config(c); }, "key 'objekt_filter' (value '{}')"},
   };
