@@ -61,13 +61,14 @@ int run(int argc, const char* const* argv) {
       if (!f.right.empty()) vimot::emit(*sink, right_channel, vimot::to_lcm_image(f.right, f.utime));
     }
     if (frames.empty() && driver.reopening()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (Clock::now() >= next_heartbeat) {
+    // The paced sink sends the heartbeat itself while it writes.
+    if (!paced && Clock::now() >= next_heartbeat) {
       process.publish_heartbeat();
       next_heartbeat = Clock::now() + std::chrono::seconds(1);
     }
   }
   report_counters(process, driver.counters());
-  process.publish_heartbeat();
+  if (!process.args().given("log")) process.publish_heartbeat();  // the final counts
   const vimot::camera::CameraCounters& c = driver.counters();
   vimot::log_info(driver.finished() ? "end of file: " : "stopping: ", c.published,
                   config.driver.stereo ? " pairs" : " images", " published, ", c.frames[0] + c.frames[1],
