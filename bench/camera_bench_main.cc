@@ -8,12 +8,11 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <string>
+#include <vector>
 
 #include "common/config/config.h"
 #include "common/eval/machine.h"
@@ -71,8 +70,9 @@ int run(int argc, const char* const* argv) {
 
   cv::setNumThreads(1);
   const eval::MachineInfo machine = eval::machine_info();
-  std::printf("vimot-bench-camera: %d stereo pairs %dx%d, cv::setNumThreads(1), process CPU time\nmachine: %d CPUs, %s\n\n",
-              frames, size.width, size.height, machine.nproc, machine.cpu_model.c_str());
+  std::printf(
+      "vimot-bench-camera: %d stereo pairs %dx%d, cv::setNumThreads(1), process CPU time\nmachine: %d CPUs, %s\n\n",
+      frames, size.width, size.height, machine.nproc, machine.cpu_model.c_str());
   std::printf("%-6s %6s | %7s %7s %7s %7s  (CPU ms per pair)\n", "codec", "pairs", "mean", "median", "p95", "max");
   for (const Codec& codec : codecs) {
     camera::CameraOptions options;
@@ -84,7 +84,8 @@ int run(int argc, const char* const* argv) {
       const std::string path = dir + "/" + codec.name + "_" + side + ".avi";
       openers.push_back([side, path] { return camera::open_video_source(side, path, camera::DeviceRequest{}); });
     }
-    camera::CameraDriver driver(options, std::move(openers), [] { return int64_t{0}; }, [](const std::string&) {});
+    camera::CameraDriver driver(
+        options, std::move(openers), [] { return int64_t{0}; }, [](const std::string&) {});
     std::vector<double> ms;
     while (!driver.finished()) {
       const std::clock_t c0 = std::clock();

@@ -82,9 +82,9 @@ SourceOpener source_opener(const CameraConfig& config, std::size_t index,
     if (source->is_file()) {
       text << "camera " << name << ": file " << spec << " at " << source->file_fps() << " Hz";
     } else {
-      text << "camera " << name << ": device " << spec << " accepted " << report.width << "x" << report.height
-           << " at " << report.fps << " Hz, exposure " << report.exposure << " x 100 us (asked " << request.width
-           << "x" << request.height << " at " << request.fps << " Hz, exposure "
+      text << "camera " << name << ": device " << spec << " accepted " << report.width << "x" << report.height << " at "
+           << report.fps << " Hz, exposure " << report.exposure << " x 100 us (asked " << request.width << "x"
+           << request.height << " at " << request.fps << " Hz, exposure "
            << (request.auto_exposure ? "auto" : std::to_string(request.exposure_s) + " s") << ")";
     }
     log(text.str());

@@ -85,8 +85,7 @@ std::optional<cv::Mat> CameraDriver::read(std::size_t index, int64_t now) {
     ++counters_.stalls;
     cam.source.reset();
     cam.next_open_utime = now + seconds_to_utime(cam.backoff_s);
-    notice_("camera " + cam.name + ": device stopped delivering; reopening in " + std::to_string(cam.backoff_s) +
-            " s");
+    notice_("camera " + cam.name + ": device stopped delivering; reopening in " + std::to_string(cam.backoff_s) + " s");
     return std::nullopt;
   }
   cam.backoff_s = options_.reopen_initial_s;

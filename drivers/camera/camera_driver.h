@@ -25,15 +25,15 @@ namespace vimot::camera {
 
 struct CameraOptions {
   bool stereo{false};
-  int width{0};   // px, every published image
+  int width{0};  // px, every published image
   int height{0};
-  bool resize{false};  // scale a frame of another size instead of failing
-  double fps{0.0};     // Hz; file-rate stamps when the file gives no rate
+  bool resize{false};                                       // scale a frame of another size instead of failing
+  double fps{0.0};                                          // Hz; file-rate stamps when the file gives no rate
   TimestampMode file_timestamps{TimestampMode::kFileRate};  // devices always use kHost
-  double latency_s{0.0};         // host stamp − exposure time
-  int64_t file_start_utime{0};   // file-rate stamp of a file's first frame
+  double latency_s{0.0};                                    // host stamp − exposure time
+  int64_t file_start_utime{0};                              // file-rate stamp of a file's first frame
   double stereo_tolerance_s{0.005};
-  std::size_t max_waiting{4};    // frames one camera queues while the other delivers none
+  std::size_t max_waiting{4};  // frames one camera queues while the other delivers none
   double reopen_initial_s{0.5};
   double reopen_max_s{8.0};
 };

@@ -14,11 +14,10 @@ FrameClock::FrameClock(TimestampMode mode, int64_t latency_us, int64_t start_uti
 }
 
 std::optional<int64_t> FrameClock::stamp(int64_t host_utime) {
-  const int64_t utime =
-      mode_ == TimestampMode::kHost
-          ? host_utime - latency_us_
-          // From the index, not by adding periods, so rounding never accumulates.
-          : start_utime_ + std::llround(static_cast<double>(index_) * 1e6 / fps_);
+  const int64_t utime = mode_ == TimestampMode::kHost
+                            ? host_utime - latency_us_
+                            // From the index, not by adding periods, so rounding never accumulates.
+                            : start_utime_ + std::llround(static_cast<double>(index_) * 1e6 / fps_);
   ++index_;
   if (last_ && utime <= *last_) {
     ++non_increasing_;

@@ -2,9 +2,8 @@
 // A delivered frame as the image vimot publishes: 8-bit grey at the
 // configured size.
 
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace vimot::camera {
 

@@ -42,9 +42,9 @@ int run(int argc, const char* const* argv) {
   // Files stamped at their rate are paced by utime (--speed) or logged
   // (--log); live stamps leave as they are captured.
   const bool paced = driver.deterministic();
-  const std::unique_ptr<vimot::EventSink> sink =
-      paced || process.args().given("log") ? vimot::make_sink(process, config.driver.file_start_utime)
-                                           : std::make_unique<vimot::LcmSink>(process, 0.0, 0, 0.0);
+  const std::unique_ptr<vimot::EventSink> sink = paced || process.args().given("log")
+                                                     ? vimot::make_sink(process, config.driver.file_start_utime)
+                                                     : std::make_unique<vimot::LcmSink>(process, 0.0, 0, 0.0);
   // A host-stamped file is read at its frame rate, as a camera would deliver it.
   const double read_period_s = paced ? 0.0 : driver.file_period_s();
   auto next_read = Clock::now();
@@ -70,11 +70,10 @@ int run(int argc, const char* const* argv) {
   report_counters(process, driver.counters());
   if (!process.args().given("log")) process.publish_heartbeat();  // the final counts
   const vimot::camera::CameraCounters& c = driver.counters();
-  vimot::log_info(driver.finished() ? "end of file: " : "stopping: ", c.published,
-                  config.driver.stereo ? " pairs" : " images", " published, ", c.frames[0] + c.frames[1],
-                  " frames read, ", c.unpaired[0] + c.unpaired[1], " unpaired, ",
-                  c.non_increasing[0] + c.non_increasing[1], " non-increasing, ", c.stalls, " stalls, ", c.reopens,
-                  " reopens");
+  vimot::log_info(
+      driver.finished() ? "end of file: " : "stopping: ", c.published, config.driver.stereo ? " pairs" : " images",
+      " published, ", c.frames[0] + c.frames[1], " frames read, ", c.unpaired[0] + c.unpaired[1], " unpaired, ",
+      c.non_increasing[0] + c.non_increasing[1], " non-increasing, ", c.stalls, " stalls, ", c.reopens, " reopens");
   vimot::linger(process, process.args().get_double("linger"));
   return 0;
 }

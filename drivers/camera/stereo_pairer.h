@@ -9,9 +9,8 @@
 
 #include <cstdint>
 #include <deque>
-#include <optional>
-
 #include <opencv2/core.hpp>
+#include <optional>
 
 namespace vimot::camera {
 

@@ -4,7 +4,6 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-
 #include <opencv2/videoio.hpp>
 
 namespace vimot::camera {
@@ -60,8 +59,8 @@ std::unique_ptr<FrameSource> open_device(const std::string& camera, const std::s
     throw CameraError("camera " + camera + ": device " + path + " does not exist");
   }
   auto capture = std::make_unique<cv::VideoCapture>();
-  const bool opened = all_digits(spec) ? capture->open(std::stoi(spec), cv::CAP_V4L2)
-                                       : capture->open(spec, cv::CAP_V4L2);
+  const bool opened =
+      all_digits(spec) ? capture->open(std::stoi(spec), cv::CAP_V4L2) : capture->open(spec, cv::CAP_V4L2);
   if (!opened || !capture->isOpened()) {
     throw CameraError("camera " + camera + ": cannot open device " + path +
                       " as a V4L2 capture device (busy, no permission, or not a camera)");
@@ -88,7 +87,8 @@ std::unique_ptr<FrameSource> open_file(const std::string& camera, const std::str
   const bool sequence = spec.find('%') != std::string::npos;
   const std::filesystem::path folder = std::filesystem::path(spec).parent_path();
   if (sequence ? !folder.empty() && !std::filesystem::is_directory(folder) : !std::filesystem::exists(spec)) {
-    throw CameraError("camera " + camera + ": " + (sequence ? "image sequence folder " + folder.string() : "video file " + spec) +
+    throw CameraError("camera " + camera + ": " +
+                      (sequence ? "image sequence folder " + folder.string() : "video file " + spec) +
                       " does not exist");
   }
   if (!sequence && std::filesystem::is_directory(spec)) {

@@ -5,11 +5,10 @@
 
 #include <functional>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 namespace vimot::camera {
 

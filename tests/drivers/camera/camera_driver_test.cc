@@ -4,15 +4,14 @@
 // offset and a dropped frame, grey conversion, sizes, the reopen back-off
 // of a device that stops delivering, and the errors for missing or bad
 // sources and configs.
-#include <catch2/catch.hpp>
+#include "drivers/camera/camera_driver.h"
 
+#include <catch2/catch.hpp>
 #include <deque>
 #include <fstream>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "drivers/camera/camera_config.h"
-#include "drivers/camera/camera_driver.h"
 #include "drivers/camera/frame_clock.h"
 #include "drivers/camera/grey_frame.h"
 #include "drivers/camera/stereo_pairer.h"
@@ -134,8 +133,9 @@ TEST_CASE("an image sequence is read through its pattern at the configured rate"
     CHECK(frames[static_cast<std::size_t>(i)].left.at<uint8_t>(5, 5) == 40 * i + 3);
   }
   o.fps = 0.0;
-  CHECK(error_of([&] { CameraDriver(o, {file_opener(dir / "frame_%04d.png")}, no_clock, quiet); })
-            .find("no frame rate") != std::string::npos);
+  CHECK(error_of([&] {
+          CameraDriver(o, {file_opener(dir / "frame_%04d.png")}, no_clock, quiet);
+        }).find("no frame rate") != std::string::npos);
 }
 
 TEST_CASE("host stamps: capture time minus latency, never backwards") {
@@ -146,8 +146,11 @@ TEST_CASE("host stamps: capture time minus latency, never backwards") {
   CameraOptions o = file_options();
   o.file_timestamps = TimestampMode::kHost;
   o.latency_s = 0.012;
-  CameraDriver driver(o, {[&] { return std::make_unique<ScriptedSource>(&clock, times, std::vector<int>{0, 1, 2, 3, 4, 5}, true); }},
-                      [&] { return clock.now; }, quiet);
+  CameraDriver driver(
+      o, {[&] {
+        return std::make_unique<ScriptedSource>(&clock, times, std::vector<int>{0, 1, 2, 3, 4, 5}, true);
+      }},
+      [&] { return clock.now; }, quiet);
   CHECK_FALSE(driver.deterministic());
   const std::vector<OutputFrame> frames = run_to_end(driver);
   REQUIRE(frames.size() == 4);
@@ -184,7 +187,7 @@ TEST_CASE("stereo: frames paired within the tolerance, a dropped frame leaves it
   for (int k = 0; k < kFrames; ++k) {
     left_times.push_back(2'000'000 + 50'000 * k);
     left_levels.push_back(10 * k);
-    if (k == 4) continue;  // the right camera drops frame 4
+    if (k == 4) continue;                                   // the right camera drops frame 4
     right_times.push_back(2'000'000 + 50'000 * k + 3'000);  // 3 ms behind the left
     right_levels.push_back(10 * k + 1);
   }
@@ -255,7 +258,8 @@ TEST_CASE("a device that stops delivering is reopened with a doubling back-off, 
   o.reopen_initial_s = 0.5;
   o.reopen_max_s = 8.0;
   std::vector<std::string> notices;
-  CameraDriver driver(o, {opener}, [&] { return clock.now; }, [&](const std::string& s) { notices.push_back(s); });
+  CameraDriver driver(
+      o, {opener}, [&] { return clock.now; }, [&](const std::string& s) { notices.push_back(s); });
   CHECK_FALSE(driver.deterministic());
   std::vector<OutputFrame> frames;
   const auto step = [&] {
@@ -336,8 +340,9 @@ TEST_CASE("missing or unreadable sources are errors naming the camera and the pa
   const std::string device = error_of([&] { open_video_source("left", "/dev/video_absent", DeviceRequest{}); });
   CHECK(device.find("camera left: device /dev/video_absent does not exist") != std::string::npos);
   if (!std::filesystem::exists("/dev/video97")) {
-    CHECK(error_of([&] { open_video_source("left", "97", DeviceRequest{}); })
-              .find("camera left: device /dev/video97 does not exist") != std::string::npos);
+    CHECK(error_of([&] {
+            open_video_source("left", "97", DeviceRequest{});
+          }).find("camera left: device /dev/video97 does not exist") != std::string::npos);
   }
   const std::string not_camera = error_of([&] { open_video_source("right", "/dev/null", DeviceRequest{}); });
   CHECK(not_camera.find("camera right: cannot open device /dev/null as a V4L2 capture device") != std::string::npos);
@@ -349,15 +354,19 @@ TEST_CASE("missing or unreadable sources are errors naming the camera and the pa
 }
 
 TEST_CASE("camera config: the shipped file, relative files, and its checks") {
-  const CameraConfig shipped = camera_config_from(vimot::Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/camera.yaml"));
+  const CameraConfig shipped =
+      camera_config_from(vimot::Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/camera.yaml"));
   CHECK(shipped.driver.stereo);
   CHECK(shipped.sources == std::vector<std::string>{"/dev/video0", "/dev/video1"});
   CHECK(shipped.request.width == 752);
   CHECK(shipped.request.auto_exposure);
 
-  const auto read = [](const std::string& text) { return camera_config_from(vimot::Config::from_string(text, "/cfg/cam.yaml")); };
-  const CameraConfig mono = read("mode: mono\nsources: {left: clip.avi}\nimage: {width: 64, height: 48, exposure: 0.004}\n"
-                                 "timing: {latency: 0.01, file_timestamps: host}\n");
+  const auto read = [](const std::string& text) {
+    return camera_config_from(vimot::Config::from_string(text, "/cfg/cam.yaml"));
+  };
+  const CameraConfig mono = read(
+      "mode: mono\nsources: {left: clip.avi}\nimage: {width: 64, height: 48, exposure: 0.004}\n"
+      "timing: {latency: 0.01, file_timestamps: host}\n");
   CHECK(mono.sources == std::vector<std::string>{"/cfg/clip.avi"});
   CHECK_FALSE(mono.request.auto_exposure);
   CHECK(mono.request.exposure_s == 0.004);
@@ -365,14 +374,16 @@ TEST_CASE("camera config: the shipped file, relative files, and its checks") {
   CHECK(mono.driver.file_timestamps == TimestampMode::kHost);
 
   const std::string base = "sources: {left: a.avi, right: b.avi}\nimage: {width: 64, height: 48}\n";
-  CHECK(error_of([&] { read("mode: stereo\n" + base + "timing: {latency: 0.01, stereo_tolerence: 1}\n"); })
-            .find("timing.stereo_tolerence") != std::string::npos);
+  CHECK(error_of([&] {
+          read("mode: stereo\n" + base + "timing: {latency: 0.01, stereo_tolerence: 1}\n");
+        }).find("timing.stereo_tolerence") != std::string::npos);
   CHECK(error_of([&] { read("mode: mono\n" + base); }).find("sources.right' is given but mode is mono") !=
         std::string::npos);
   CHECK(error_of([&] { read("mode: trinocular\n" + base); }).find("'mode' must be 'mono' or 'stereo'") !=
         std::string::npos);
   CHECK(error_of([&] { read("mode: stereo\n" + base + "timing: {latency: -0.01}\n"); }).find("timing.latency") !=
         std::string::npos);
-  CHECK(error_of([&] { read("mode: stereo\nsources: {left: a.avi, right: b.avi}\nimage: {width: 64, height: 48, exposure: fast}\n"); })
-            .find("image.exposure") != std::string::npos);
+  CHECK(error_of([&] {
+          read("mode: stereo\nsources: {left: a.avi, right: b.avi}\nimage: {width: 64, height: 48, exposure: fast}\n");
+        }).find("image.exposure") != std::string::npos);
 }

@@ -2,20 +2,18 @@
 // videos as a stereo pair arrive on the configured channels, every frame,
 // in order, grey, at their file-rate stamps, with a heartbeat that counts
 // them; --help and a missing file exit as they should.
-#include <catch2/catch.hpp>
-
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <fstream>
+#include <lcm/lcm-cpp.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <lcm/lcm-cpp.hpp>
 
 #include "tests/drivers/camera/test_video.h"
 #include "vimot/heartbeat_t.hpp"

@@ -7,10 +7,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <string>
-
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
+#include <string>
 
 namespace vimot::camera::test {
 
