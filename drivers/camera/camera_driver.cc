@@ -1,6 +1,7 @@
 #include "drivers/camera/camera_driver.h"
 
 #include <algorithm>
+#include <sstream>
 
 #include "common/time/utime.h"
 #include "drivers/camera/grey_frame.h"
@@ -10,6 +11,12 @@ namespace vimot::camera {
 namespace {
 
 const char* const kNames[2] = {"left", "right"};
+
+std::string seconds_text(double s) {
+  std::ostringstream text;
+  text << s << " s";
+  return text.str();
+}
 
 }  // namespace
 
@@ -71,7 +78,7 @@ std::optional<cv::Mat> CameraDriver::read(std::size_t index, int64_t now) {
       ++counters_.reopen_failures;
       cam.backoff_s = std::min(2.0 * cam.backoff_s, options_.reopen_max_s);
       cam.next_open_utime = now + seconds_to_utime(cam.backoff_s);
-      notice_(std::string(e.what()) + "; next attempt in " + std::to_string(cam.backoff_s) + " s");
+      notice_(std::string(e.what()) + "; next attempt in " + seconds_text(cam.backoff_s));
       return std::nullopt;
     }
   }
@@ -85,7 +92,7 @@ std::optional<cv::Mat> CameraDriver::read(std::size_t index, int64_t now) {
     ++counters_.stalls;
     cam.source.reset();
     cam.next_open_utime = now + seconds_to_utime(cam.backoff_s);
-    notice_("camera " + cam.name + ": device stopped delivering; reopening in " + std::to_string(cam.backoff_s) + " s");
+    notice_("camera " + cam.name + ": device stopped delivering; reopening in " + seconds_text(cam.backoff_s));
     return std::nullopt;
   }
   cam.backoff_s = options_.reopen_initial_s;

@@ -288,8 +288,10 @@ TEST_CASE("a device that stops delivering is reopened with a doubling back-off, 
   REQUIRE(frames.size() == 5);
   for (std::size_t i = 1; i < frames.size(); ++i) CHECK(frames[i].utime > frames[i - 1].utime);
   CHECK(frames[3].left.at<uint8_t>(0, 0) == 3);
-  CHECK(notices.size() >= 3);
-  CHECK(notices[0].find("stopped delivering") != std::string::npos);
+  REQUIRE(notices.size() == 3);  // the stall, the failed attempt, the reopen
+  CHECK(notices[0].find("camera left: device stopped delivering; reopening in 0.5 s") != std::string::npos);
+  CHECK(notices[1].find("/dev/video7 does not exist; next attempt in 1 s") != std::string::npos);
+  CHECK(notices[2] == "camera left: reopened");
 }
 
 TEST_CASE("grey conversion of BGR, BGRA and grey frames; wrong size and type") {
