@@ -15,6 +15,8 @@
 #include "drivers/camera/frame_clock.h"
 #include "drivers/camera/grey_frame.h"
 #include "drivers/camera/stereo_pairer.h"
+#include "drivers/euroc_player/euroc_player.h"
+#include "tests/data_dir.h"
 #include "tests/drivers/camera/test_video.h"
 
 using namespace vimot::camera;
@@ -388,4 +390,43 @@ TEST_CASE("camera config: the shipped file, relative files, and its checks") {
   CHECK(error_of([&] {
           read("mode: stereo\nsources: {left: a.avi, right: b.avi}\nimage: {width: 64, height: 48, exposure: fast}\n");
         }).find("image.exposure") != std::string::npos);
+}
+
+TEST_CASE("the EuRoC slice's cameras as image sequences: the player's pairs, pixels and stamps", "[data]") {
+  const std::string csv = vimot::test_data_file_or_skip("euroc_v101_micro/mav0/cam0/data.csv", "EuRoC slice");
+  if (csv.empty()) return;
+  vimot::euroc::PlayerOptions player_options;
+  player_options.dataset = csv.substr(0, csv.size() - std::string("/mav0/cam0/data.csv").size());
+  vimot::euroc::EurocPlayer player(player_options);
+  std::vector<vimot::euroc::StereoFrame> truth;
+  while (const auto event = player.next()) {
+    if (const auto* frame = std::get_if<vimot::euroc::StereoFrame>(&*event)) truth.push_back(*frame);
+  }
+  REQUIRE(truth.size() == 95);
+  // The slice's frames are exactly 50 ms apart (in µs): an image sequence at
+  // 20 Hz from the first pair's time carries the dataset's own stamps.
+  TempDir dir;
+  for (const char* side : {"left", "right"}) std::filesystem::create_directory(dir / side);
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const std::string name = cv::format("frame_%04d.png", static_cast<int>(i));
+    std::filesystem::create_symlink(truth[i].left_path, dir / ("left/" + name));
+    std::filesystem::create_symlink(truth[i].right_path, dir / ("right/" + name));
+  }
+  CameraOptions o = file_options(true);
+  o.width = player.summary().width;
+  o.height = player.summary().height;
+  o.fps = 20.0;
+  o.file_start_utime = truth.front().utime;
+  CameraDriver driver(o, {file_opener(dir / "left/frame_%04d.png"), file_opener(dir / "right/frame_%04d.png")},
+                      no_clock, quiet);
+  const std::vector<OutputFrame> pairs = run_to_end(driver);
+  REQUIRE(pairs.size() == truth.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    INFO("pair " << i);
+    CHECK(pairs[i].utime == truth[i].utime);
+    const vimot::euroc::StereoImages images = player.load_images(truth[i]);
+    CHECK(cv::norm(pairs[i].left, images.left, cv::NORM_INF) == 0.0);
+    CHECK(cv::norm(pairs[i].right, images.right, cv::NORM_INF) == 0.0);
+  }
+  CHECK(driver.counters().unpaired[0] + driver.counters().unpaired[1] == 0);
 }
