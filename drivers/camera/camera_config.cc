@@ -11,7 +11,7 @@ CameraConfig camera_config_from(const Config& config) {
   config.check_keys("sources", {"left", "right"});
   config.check_keys("image", {"width", "height", "fps", "exposure", "resize"});
   config.check_keys("timing", {"latency", "stereo_tolerance", "file_timestamps", "file_start"});
-  config.check_keys("reopen", {"initial_interval", "max_interval"});
+  config.check_keys("reopen", {"stall_timeout", "initial_interval", "max_interval"});
   config.check_keys("channels", {"cam_left", "cam_right", "heartbeat"});
 
   CameraConfig c;
@@ -68,6 +68,8 @@ CameraConfig camera_config_from(const Config& config) {
     o.reopen_max_s = r.get_or<double>("max_interval", o.reopen_max_s);
     if (o.reopen_initial_s <= 0.0) r.fail("initial_interval", "must be > 0 s");
     if (o.reopen_max_s < o.reopen_initial_s) r.fail("max_interval", "must be >= initial_interval");
+    c.stall_timeout_s = r.get_or<int>("stall_timeout", c.stall_timeout_s);
+    if (c.stall_timeout_s < 1) r.fail("stall_timeout", "must be >= 1 s (whole seconds)");
   }
   return c;
 }

@@ -15,6 +15,7 @@ namespace vimot::camera {
 struct CameraConfig {
   std::vector<std::string> sources;  // left[, right]: "/dev/videoN", an index, a file or "dir/frame_%04d.png"
   DeviceRequest request;             // asked of V4L2 devices
+  int stall_timeout_s{2};            // s a device read waits for a frame before it counts as a stall
   CameraOptions driver;
 };
 

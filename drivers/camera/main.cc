@@ -3,6 +3,7 @@
 // stereo). Capture, stamping, pairing and reopening are CameraDriver (no
 // LCM); this file paces, converts and reports.
 #include <chrono>
+#include <cstdlib>
 #include <thread>
 
 #include "common/process/event_sink.h"
@@ -26,12 +27,15 @@ int run(int argc, const char* const* argv) {
                          "One camera (mode: mono) or two paired by time (mode: stereo): V4L2 devices or video\n"
                          "files through OpenCV, published as 8-bit grey image_t on CAM_LEFT / CAM_RIGHT.\n"
                          "Configured by config/camera.yaml (sources, image, timing, reopen, channels).\n"
-                         "--speed and --log apply to files stamped at their frame rate.",
+                         "--speed paces files stamped at their frame rate; --log writes an LCM log instead.",
                          /*config_required=*/true);
   vimot::add_sink_options(process.args());
   if (!process.init(argc, argv)) return 0;
 
   const vimot::camera::CameraConfig config = vimot::camera::camera_config_from(process.config());
+  // OpenCV's V4L2 backend waits this long (default 10 s) for a frame and
+  // reads it once, at the first capture: set before any device opens.
+  setenv("OPENCV_VIDEOIO_V4L_SELECT_TIMEOUT", std::to_string(config.stall_timeout_s).c_str(), 1);
   const auto log = [](const std::string& text) { vimot::log_info(text); };
   std::vector<vimot::camera::SourceOpener> openers;
   for (std::size_t i = 0; i < config.sources.size(); ++i) openers.push_back(source_opener(config, i, log));

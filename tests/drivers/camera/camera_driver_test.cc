@@ -364,6 +364,7 @@ TEST_CASE("camera config: the shipped file, relative files, and its checks") {
   CHECK(shipped.sources == std::vector<std::string>{"/dev/video0", "/dev/video1"});
   CHECK(shipped.request.width == 752);
   CHECK(shipped.request.auto_exposure);
+  CHECK(shipped.stall_timeout_s == 2);
 
   const auto read = [](const std::string& text) {
     return camera_config_from(vimot::Config::from_string(text, "/cfg/cam.yaml"));
@@ -385,6 +386,9 @@ TEST_CASE("camera config: the shipped file, relative files, and its checks") {
         std::string::npos);
   CHECK(error_of([&] { read("mode: trinocular\n" + base); }).find("'mode' must be 'mono' or 'stereo'") !=
         std::string::npos);
+  CHECK(error_of([&] {
+          read("mode: stereo\n" + base + "reopen: {stall_timeout: 0}\n");
+        }).find("reopen.stall_timeout' must be >= 1 s") != std::string::npos);
   CHECK(error_of([&] { read("mode: stereo\n" + base + "timing: {latency: -0.01}\n"); }).find("timing.latency") !=
         std::string::npos);
   CHECK(error_of([&] {
