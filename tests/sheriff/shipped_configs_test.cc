@@ -47,6 +47,8 @@ TEST_CASE("shipped sheriff configs parse") {
                {"vins_euroc.yaml", "feature_tracker.yaml"});
   check_config("sim_pixels.pmd", {"logger", "vins", "target_filter", "feature_tracker", "sim"},
                {"target_filter.yaml"});
+  check_config("sim_mono_pixels.pmd", {"logger", "vins", "object_tracker", "scale_estimator", "feature_tracker", "sim"},
+               {"vins_mono.yaml", "object_tracker.yaml", "scale_estimator.yaml", "feature_tracker_sim_mono.yaml"});
 }
 
 TEST_CASE("the two-host layout puts each command on its machine") {
