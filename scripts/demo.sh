@@ -32,8 +32,10 @@
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
 #                     sim_mono.yaml)
 #   VIMOT_SPEED       simulator real-time factor (default 2; mono and pixels: 1,
-#                     mono-pixels: 0.5 (rendering, tracking and the bundle
-#                     adjustment ≈ 40 ms of a 50 ms frame on a loaded core),
+#                     mono-pixels: 0.5, but the object tracker's bundle
+#                     adjustment on the long target KLT tracks takes ≈ 200 ms
+#                     per frame, so it falls behind and the demo fails (exit 4)
+#                     unless the speed is lower (docs/scale_estimator.md),
 #                     the object tracker's bundle adjustment takes ≈ 20 ms per
 #                     frame; on 2 cores at 4x UDP already loses IMU messages,
 #                     which the heartbeats count, and the demo then fails)
