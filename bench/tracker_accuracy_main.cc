@@ -85,6 +85,11 @@ int run(int argc, const char* const* argv) {
   row("static, no box", e, [&](const E& x) { return stat(x) && !std::isfinite(x.box_distance_px); });
   row("target, all", e, [](const E& x) { return x.is_target; });
   row("target, born off target", e, [](const E& x) { return x.is_target && !x.born_on_target; });
+  for (int a = 0; a + 1 < 6; ++a) {
+    const std::string name = "target, age " + std::to_string(ages[a]) + "-" +
+                             (ages[a + 1] == (1 << 30) ? std::string("") : std::to_string(ages[a + 1] - 1));
+    row(name, e, [&](const E& x) { return x.is_target && x.age >= ages[a] && x.age < ages[a + 1]; });
+  }
   return 0;
 }
 

@@ -4,6 +4,7 @@
 #   scripts/demo.sh mono   monocular metric scale (scale paper)
 #   scripts/demo.sh pixels stereo target tracking from rendered images: the
 #                          simulator renders, the feature tracker makes FEATURES
+#   scripts/demo.sh mono-pixels  monocular metric scale from rendered images
 # Installs what is missing, builds, starts the processes of a sheriff config
 # with vimot-sheriff and prints a summary: processes, messages per channel,
 # the accuracy of the LCM run against ground truth, the same scenario run
@@ -20,16 +21,27 @@
 #    lcm-logger): VIO accuracy of the LCM run against the same seed's
 #    offline run from pixels (vimot-vio-eval --pixels) and next to the
 #    feature-level run of that seed.
+#  - mono-pixels: sheriff_configs/sim_mono_pixels.pmd (simulator rendering
+#    cam0, feature tracker with the true target box, vins, object tracker,
+#    scale estimator, lcm-logger): VIO accuracy and the scale figures of the
+#    LCM run against the same seed's offline runs from pixels
+#    (vimot-vio-eval --pixels, vimot-scale-eval --pixels); exits 4 if
+#    either differs.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
 #                     sim_mono.yaml)
 #   VIMOT_SPEED       simulator real-time factor (default 2; mono and pixels: 1,
+#                     mono-pixels: 0.5, but the object tracker's bundle
+#                     adjustment on the long target KLT tracks takes ≈ 200 ms
+#                     per frame, so it falls behind and the demo fails (exit 4)
+#                     unless the speed is lower (docs/scale_estimator.md),
 #                     the object tracker's bundle adjustment takes ≈ 20 ms per
 #                     frame; on 2 cores at 4x UDP already loses IMU messages,
 #                     which the heartbeats count, and the demo then fails)
 #   VIMOT_SEED        noise seed (default 1)
-#   VIMOT_DURATION    pixels: seconds to simulate (default 30; rendering and
+#   VIMOT_DURATION    pixels: seconds to simulate (default 30; mono-pixels 60,
+#                     the scale estimator's 40 s window needs most of it; rendering and
 #                     tracking cost ≈ 25 ms per stereo frame, so the default
 #                     speed there is 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml; mono:
@@ -49,8 +61,9 @@ case "${1:-}" in
   -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
   mono) pipeline=mono ;;
   pixels) pipeline=pixels ;;
+  mono-pixels) pipeline=mono_pixels ;;
   "") ;;
-  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels' or --help)" >&2; exit 1 ;;
+  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels', 'mono-pixels' or --help)" >&2; exit 1 ;;
 esac
 
 "$here/scripts/build.sh"
@@ -68,6 +81,14 @@ elif [ $pipeline = pixels ]; then
   export VIMOT_TRACKER_CONFIG="${VIMOT_TRACKER_CONFIG:-feature_tracker_sim.yaml}"
   export VIMOT_DURATION="${VIMOT_DURATION:-30}"
   export VIMOT_SPEED="${VIMOT_SPEED:-1}"
+elif [ $pipeline = mono_pixels ]; then
+  pmd="$here/sheriff_configs/sim_mono_pixels.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_mono.yaml}"
+  export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
+  # The tracker config sim_mono_pixels.pmd runs (the offline runs take it too).
+  export VIMOT_TRACKER_CONFIG=feature_tracker_sim_mono.yaml
+  export VIMOT_DURATION="${VIMOT_DURATION:-60}"
+  export VIMOT_SPEED="${VIMOT_SPEED:-0.5}"
 else
   pmd="$here/sheriff_configs/sim_demo.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
@@ -101,7 +122,7 @@ echo "== VIO accuracy of the LCM run (VINS_STATE vs GROUND_TRUTH):"
 perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" | head -n 1)
 # The same seed offline, in-process: the figures the LCM run must equal.
 offline_args=()
-if [ $pipeline = pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = mono_pixels ]; then
   offline_args=(--duration "$VIMOT_DURATION" --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG")
 fi
 "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
@@ -129,6 +150,27 @@ if [ $pipeline = pixels ]; then
     --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
     --duration "$VIMOT_DURATION" --perturb-seed "${perturb_seed:-0}" --quiet > "$out/offline_features.txt" 2>&1 || true
   grep -E '^(seed|mean|pred)' "$out/offline_features.txt" | sed 's/^/   /'
+  echo "== log (images left out): $VIMOT_LOG"
+  finish
+fi
+if [ $pipeline = mono_pixels ]; then
+  echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run from pixels:"
+  "$VIMOT_BIN/vimot-scale-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+    --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --tracker-config "$VIMOT_CONFIG/object_tracker.yaml" \
+    --scale-config "$VIMOT_CONFIG/scale_estimator.yaml" --runs 1 --first-seed "$VIMOT_SEED" \
+    --perturb-seed "${perturb_seed:-0}" --duration "$VIMOT_DURATION" \
+    --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG" --out "$out/offline_scale" --quiet > "$out/offline_scale.txt" 2>&1 || true
+  grep -E '^(seed|mean)' "$out/offline_scale.txt" | sed 's/^/   /' || true
+  scale_status=0
+  "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --scale-truth "$out/offline_scale/summary.json" --tolerance 1e-6 \
+    > "$out/lcm_vs_offline_scale.txt" 2>&1 || scale_status=$?
+  grep -E '^(scale|metric|filtered|compare|  (scale|accepted|last|object|filtered))' "$out/lcm_vs_offline_scale.txt" \
+    | sed 's/^/   /' || true
+  if [ "$scale_status" -ne 0 ] && [ "$lcm_vs_offline" -eq 0 ]; then
+    lcm_vs_offline=$scale_status
+    cat "$out/lcm_vs_offline_scale.txt" >> "$out/lcm_vs_offline.txt"
+  fi
+  echo "   (offline run: $out/offline_scale.txt)"
   echo "== log (images left out): $VIMOT_LOG"
   finish
 fi

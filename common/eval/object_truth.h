@@ -13,10 +13,13 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "common/object/object_tracker.h"
+#include "common/sim/renderer.h"
 #include "common/sim/simulator.h"
+#include "common/types/sensor_data.h"
 
 namespace vimot {
 namespace eval {
@@ -27,15 +30,19 @@ struct TargetInCamera {
   Eigen::Vector3d p_TinC{Eigen::Vector3d::Zero()};
 };
 
-inline TargetInCamera true_target_in_camera(const sim::Simulator& sim, int64_t utime) {
-  const double t = sim.sim_time(utime);
-  const sim::SplineState robot = sim.robot_state(t);
-  const sim::SplineState target = sim.target_state(t).value();
+/// True pose of the world G in cam0 at a utime (R_GtoC, p_GinC as R_TtoC, p_TinC).
+inline TargetInCamera true_world_in_camera(const sim::Simulator& sim, int64_t utime) {
+  const sim::SplineState robot = sim.robot_state(sim.sim_time(utime));
   const CameraCalibration& cam = sim.cameras().at(0);
   // p_C = R_ItoC p_I + p_IinC and p_I = R_GtoI (p_G - p_IinG).
   const Eigen::Matrix3d R_GtoC = cam.R_ItoC * robot.R_BtoG.transpose();
-  const Eigen::Vector3d p_GinC = cam.p_IinC - R_GtoC * robot.p_BinG;
-  return {R_GtoC * target.R_BtoG, R_GtoC * target.p_BinG + p_GinC};
+  return {R_GtoC, cam.p_IinC - R_GtoC * robot.p_BinG};
+}
+
+inline TargetInCamera true_target_in_camera(const sim::Simulator& sim, int64_t utime) {
+  const sim::SplineState target = sim.target_state(sim.sim_time(utime)).value();
+  const TargetInCamera g = true_world_in_camera(sim, utime);
+  return {g.R_TtoC * target.R_BtoG, g.R_TtoC * target.p_BinG + g.p_TinC};
 }
 
 /// The true object frame of one track: O in T and the true scale.
@@ -48,6 +55,24 @@ struct ObjectTruth {
   Eigen::Vector3d p_OinC(const TargetInCamera& x) const { return x.R_TtoC * p_OinT + x.p_TinC; }
 };
 
+/// The true object frame of a track whose reference features lie at the
+/// true distances `distances` (m) from cam0 at facts.reference_utime.
+inline ObjectTruth object_truth_at_distances(const sim::Simulator& sim, const InitFacts& facts,
+                                             std::vector<double> distances) {
+  if (distances.empty()) throw std::runtime_error("object truth: no reference feature");
+  const TargetInCamera x0 = true_target_in_camera(sim, facts.reference_utime);
+  // Same median as the tracker: the upper middle element.
+  const auto mid = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), mid, distances.end());
+  ObjectTruth truth;
+  truth.s_true = *mid;
+  truth.R_OtoT = x0.R_TtoC.transpose();
+  truth.p_OinT = x0.R_TtoC.transpose() * (truth.s_true * facts.centre_ray_C0 - x0.p_TinC);
+  return truth;
+}
+
+/// The true object frame of a track on the simulator's own feature tracks
+/// (feature ids name the simulator's landmarks).
 inline ObjectTruth object_truth(const sim::Simulator& sim, const InitFacts& facts) {
   const TargetInCamera x0 = true_target_in_camera(sim, facts.reference_utime);
   std::vector<double> distances;
@@ -59,14 +84,26 @@ inline ObjectTruth object_truth(const sim::Simulator& sim, const InitFacts& fact
     const Eigen::Vector3d& p_FinT = sim.landmarks()[static_cast<std::size_t>(landmark)].p;
     distances.push_back((x0.R_TtoC * p_FinT + x0.p_TinC).norm());
   }
-  // Same median as the tracker: the upper middle element.
-  const auto mid = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
-  std::nth_element(distances.begin(), mid, distances.end());
-  ObjectTruth truth;
-  truth.s_true = *mid;
-  truth.R_OtoT = x0.R_TtoC.transpose();
-  truth.p_OinT = x0.R_TtoC.transpose() * (truth.s_true * facts.centre_ray_C0 - x0.p_TinC);
-  return truth;
+  return object_truth_at_distances(sim, facts, std::move(distances));
+}
+
+/// The same from pixels, where feature ids are the feature tracker's, not
+/// the simulator's landmarks: a reference feature's true distance is that of
+/// the surface its cam0 pixel in `reference` (the frame at
+/// facts.reference_utime) shows, by the renderer's ray cast.
+inline ObjectTruth object_truth_from_pixels(const sim::Simulator& sim, const sim::Renderer& renderer,
+                                            const InitFacts& facts, const CameraFrame& reference) {
+  if (reference.utime != facts.reference_utime) throw std::invalid_argument("object truth: not the reference frame");
+  const TargetInCamera g = true_world_in_camera(sim, facts.reference_utime);
+  std::vector<double> distances;
+  for (int64_t id : facts.reference_feature_ids) {
+    for (const FeatureObservation& f : reference.observations) {
+      if (f.camera_id != 0 || f.feature_id != id) continue;
+      const sim::Renderer::SurfaceHit hit = renderer.surface_at(0, facts.reference_utime, f.pixel);
+      distances.push_back((g.R_TtoC * hit.p_inG + g.p_TinC).norm());
+    }
+  }
+  return object_truth_at_distances(sim, facts, std::move(distances));
 }
 
 }  // namespace eval

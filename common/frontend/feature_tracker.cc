@@ -207,6 +207,47 @@ void FeatureTracker::match_static_stereo(const std::optional<Box>& box_right) {
   right.swap(kept);
 }
 
+std::vector<FeatureTracker::TargetPoint> FeatureTracker::klt_target(int cam, const Box& box) {
+  const auto c = static_cast<std::size_t>(cam);
+  const std::vector<TargetPoint>& prev = target_[c];
+  if (prev.empty() || prev_pyramid_[c].empty()) return {};
+  const StaticTrackOptions& o = options_.static_tracks;
+  cv::Point2f shift(0.f, 0.f);
+  if (prev_box_[c]) {
+    shift = cv::Point2f(static_cast<float>(box.center_u() - prev_box_[c]->center_u()),
+                        static_cast<float>(box.center_v() - prev_box_[c]->center_v()));
+  }
+  std::vector<cv::Point2f> from, to;
+  for (const TargetPoint& t : prev) {
+    from.push_back(t.point.pixel);
+    to.push_back(t.point.pixel + shift);
+  }
+  std::vector<uint8_t> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(
+      prev_pyramid_[c], pyramid_[c], from, to, status, error, cv::Size(o.klt_window_px, o.klt_window_px),
+      o.klt_pyramid_levels,
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations, o.klt_epsilon),
+      cv::OPTFLOW_USE_INITIAL_FLOW);
+  std::vector<Eigen::Vector2d> a, b;
+  std::vector<TargetPoint> out;
+  for (std::size_t i = 0; i < prev.size(); ++i) {
+    if (!status[i] || !box.contains(to[i].x, to[i].y)) continue;
+    TargetPoint t = prev[i];
+    t.point.pixel = to[i];
+    if (!normalize(cam, &t.point)) continue;
+    a.push_back(prev[i].point.normalized);
+    b.push_back(t.point.normalized);
+    out.push_back(t);
+  }
+  const std::vector<bool> in = ransac_.inliers(a, b, focal(cam, cam));
+  std::vector<TargetPoint> kept;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (in[i]) kept.push_back(out[i]);
+  }
+  return kept;
+}
+
 void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes) {
   const std::size_t n = cameras_.size();
   const TargetTrackOptions& o = options_.target;
@@ -214,17 +255,29 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
   std::vector<std::vector<Descriptor>> cur_desc(n);
   for (std::size_t c = 0; c < n; ++c) {
     if (!boxes[c]) continue;
+    const int cam = static_cast<int>(c);
+    if (o.klt()) cur[c] = klt_target(cam, *boxes[c]);
+    const std::size_t tracked = cur[c].size();
+    const double min_d2 = o.min_distance_px * o.min_distance_px;
     for (const OrbFeature& f : orb_.detect(images[c], *boxes[c])) {
+      if (cur[c].size() >= static_cast<std::size_t>(o.num_features)) break;
+      const bool near_tracked = std::any_of(cur[c].begin(), cur[c].begin() + static_cast<std::ptrdiff_t>(tracked),
+                                            [&](const TargetPoint& t) {
+                                              const cv::Point2f d = t.point.pixel - f.pixel;
+                                              return d.dot(d) < min_d2;
+                                            });
+      if (near_tracked) continue;
       TargetPoint t;
       t.point.pixel = f.pixel;
       t.descriptor = f.descriptor;
-      if (normalize(static_cast<int>(c), &t.point)) cur[c].push_back(t);
+      if (normalize(cam, &t.point)) cur[c].push_back(t);
     }
     for (const TargetPoint& t : cur[c]) cur_desc[c].push_back(t.descriptor);
   }
 
-  // Frame to frame in each camera, gated by the motion left after the box's.
-  for (std::size_t c = 0; c < n; ++c) {
+  // Frame to frame by descriptor in each camera, gated by the motion left
+  // after the box's ("klt" has followed them already).
+  for (std::size_t c = 0; c < n && !o.klt(); ++c) {
     const std::vector<TargetPoint>& prev = target_[c];
     if (prev.empty() || cur[c].empty()) continue;
     cv::Point2f shift(0.f, 0.f);

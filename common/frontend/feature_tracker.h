@@ -84,6 +84,10 @@ class FeatureTracker {
   void detect_static(const std::optional<Box>& box);
   void match_static_stereo(const std::optional<Box>& box_right);
   void track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes);
+  /// target.frame_to_frame klt: the previous frame's target points of `cam`
+  /// followed into this frame by KLT (the guess shifted by the box's
+  /// motion), kept inside `box`, cleaned by RANSAC; ids and descriptors kept.
+  std::vector<TargetPoint> klt_target(int cam, const Box& box);
   /// KLT from one pyramid to another; keeps points that converge inside
   /// `to_cam`'s image, outside `to_box`, with an undistortable pixel.
   std::vector<Point> klt(const std::vector<cv::Mat>& from_pyr, int to_cam, const std::vector<cv::Mat>& to_pyr,

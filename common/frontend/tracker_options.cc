@@ -57,6 +57,9 @@ void TargetTrackOptions::validate() const {
   require(loop_closure_max_hamming >= 0 && loop_closure_max_hamming <= 256,
           "target.loop_closure_max_hamming must be in 0..256");
   require(max_stored_points >= 0, "target.max_stored_points must be >= 0");
+  require(frame_to_frame == "orb" || frame_to_frame == "klt",
+          "target.frame_to_frame must be orb or klt, got '" + frame_to_frame + "'");
+  require(min_distance_px >= 0.0, "target.min_distance_px must be >= 0");
 }
 
 void RansacOptions::validate() const {
@@ -82,7 +85,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
              "max_track_frames"});
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
-             "max_motion_px", "loop_closure_max_hamming", "max_stored_points"});
+             "max_motion_px", "loop_closure_max_hamming", "max_stored_points", "frame_to_frame", "min_distance_px"});
   only_keys(cfg, s + "ransac", {"threshold_px", "confidence", "max_iterations", "min_points", "seed"});
 
   StaticTrackOptions& st = o.static_tracks;
@@ -109,6 +112,8 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "target.max_motion_px", &t.max_motion_px);
   read(cfg, s + "target.loop_closure_max_hamming", &t.loop_closure_max_hamming);
   read(cfg, s + "target.max_stored_points", &t.max_stored_points);
+  read(cfg, s + "target.frame_to_frame", &t.frame_to_frame);
+  read(cfg, s + "target.min_distance_px", &t.min_distance_px);
 
   RansacOptions& r = o.ransac;
   read(cfg, s + "ransac.threshold_px", &r.threshold_px);

@@ -6,7 +6,7 @@
 //            klt_max_iterations, klt_epsilon
 //   target:  num_features, orb_fast_threshold, orb_levels, orb_scale_factor,
 //            max_hamming, match_ratio, max_motion_px, loop_closure_max_hamming,
-//            max_stored_points
+//            max_stored_points, frame_to_frame, min_distance_px
 //   ransac:  threshold_px, confidence, max_iterations, min_points, seed
 // Every key is optional; an unknown key is an error naming it. Meanings and
 // defaults: docs/feature_tracker.md.
@@ -54,6 +54,15 @@ struct TargetTrackOptions {
   double max_motion_px{80.0};        // frame to frame, after the box's own motion
   int loop_closure_max_hamming{40};  // stricter: no geometry checks a re-identification
   int max_stored_points{500};        // descriptors kept for loop closure (oldest dropped)
+  // Frame to frame: "orb" re-detects every frame and matches descriptors
+  // (a point continues only if ORB finds it again: ~55 % per frame on a
+  // small box); "klt" follows the previous frame's points by pyramidal KLT
+  // (the static options' window, levels and stop criteria) and tops up with
+  // ORB corners at least min_distance_px from a tracked point. Long tracks
+  // are what the monocular object tracker's initialisation needs.
+  std::string frame_to_frame{"orb"};
+  double min_distance_px{5.0};  // "klt": no new corner this close to a tracked target point
+  bool klt() const { return frame_to_frame == "klt"; }
   void validate() const;
 };
 

@@ -271,6 +271,12 @@ object_pose_t to_lcm(const ObjectPoseEstimate& e) {
   return msg;
 }
 
+std::optional<frontend::Box> box_of(const target_box_t& m) {
+  const double* b = m.filtered_valid ? m.filtered_box : (m.raw_valid ? m.raw_box : nullptr);
+  if (b == nullptr) return std::nullopt;
+  return frontend::Box{b[0], b[1], b[2], b[3]};
+}
+
 ObjectPoseEstimate from_lcm(const object_pose_t& msg) {
   ObjectPoseEstimate e;
   e.utime = msg.utime;

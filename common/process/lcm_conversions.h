@@ -4,6 +4,9 @@
 // get wrong (non-finite numbers, bad counts, camera ids) and throws
 // std::invalid_argument saying what; the scaffold counts it as an error.
 
+#include <optional>
+
+#include "common/frontend/box.h"
 #include "common/object/scale_estimator.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
@@ -17,6 +20,7 @@
 #include "vimot/nav_state_t.hpp"
 #include "vimot/object_pose_t.hpp"
 #include "vimot/scale_estimate_t.hpp"
+#include "vimot/target_box_t.hpp"
 #include "vimot/target_prediction_t.hpp"
 #include "vimot/target_state_t.hpp"
 
@@ -39,6 +43,11 @@ TargetStateEstimate from_lcm(const target_state_t& msg);
 
 target_prediction_t to_lcm(const TargetPosePrediction& prediction);
 TargetPosePrediction from_lcm(const target_prediction_t& msg);
+
+/// A target box message's box: the filtered box when the box filter holds
+/// one, else this frame's raw detection, else none. Values are not checked
+/// (the feature tracker counts a non-finite box as an error).
+std::optional<frontend::Box> box_of(const target_box_t& msg);
 
 // Object tracker (issue 5).
 object_pose_t to_lcm(const ObjectPoseEstimate& estimate);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <stdexcept>
 
 #include "common/estimator/initial_estimate.h"
@@ -13,6 +14,22 @@
 
 namespace vimot {
 namespace eval {
+
+namespace {
+
+// Frames kept for object_truth_from_pixels: the reference frame is the first of the
+// object tracker's initialisation buffer (init_frames, 40 by default), which
+// may slide on for a while before the tracker commits.
+constexpr std::size_t kRecentFrames = 400;
+
+const CameraFrame& reference_frame(const std::deque<CameraFrame>& recent, const InitFacts& facts) {
+  const auto frame = std::find_if(recent.begin(), recent.end(),
+                                  [&facts](const CameraFrame& f) { return f.utime == facts.reference_utime; });
+  if (frame == recent.end()) throw std::runtime_error("object truth: the reference frame is no longer kept");
+  return *frame;
+}
+
+}  // namespace
 
 ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEvalOptions& options,
                                 uint64_t perturb_seed, const std::function<void(double)>& progress) {
@@ -67,8 +84,13 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
     truth = gt;
     have_truth = true;
   };
+  std::deque<CameraFrame> recent_frames;  // from pixels: the reference frame's pixels give the true distances
   play_simulator(sim, est, on_truth, [&](const CameraFrame& frame) {
     ++r.frames;
+    if (pixels) {
+      recent_frames.push_back(frame);
+      if (recent_frames.size() > kRecentFrames) recent_frames.pop_front();
+    }
     if (progress) progress(static_cast<double>(r.frames) / static_cast<double>(frames_total));
     const estimator::FrameStatus st = est.feed_camera(frame);  // it leaves the target's observations out
     if (st == estimator::FrameStatus::kDiverged) {
@@ -76,13 +98,21 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
       r.divergence_reason = est.last_divergence().reason;
       return false;
     }
+    if (pixels && !pixels->last_views().empty() && pixels->last_views()[0].visible) {
+      // TARGET_BOX_TRUTH, as vimot-sim --render publishes it with the image.
+      const Eigen::Vector4d& b = pixels->last_views()[0].box;
+      tracker.on_box(frame.utime, BoundingBox2d{b.head<2>(), b.head<2>() + b.tail<2>()});
+    }
     const auto t0 = std::chrono::steady_clock::now();
     tracker.on_frame(frame);
     tracker_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (tracked.valid) {
       ++r.tracker_valid_frames;
       if ((r.tracks.empty() || r.tracks.back().track_id != tracked.track_id) && tracker.tracker().init_facts()) {
-        TrackTruth t{tracked.track_id, tracked.utime, object_truth(sim, *tracker.tracker().init_facts())};
+        const InitFacts& facts = *tracker.tracker().init_facts();
+        TrackTruth t{tracked.track_id, tracked.utime,
+                     pixels ? object_truth_from_pixels(sim, pixels->renderer(), facts, reference_frame(recent_frames, facts))
+                            : object_truth(sim, facts)};
         figures.start_track(t.start_utime, t.truth);
         r.tracks.push_back(t);
       }

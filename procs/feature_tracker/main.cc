@@ -16,14 +16,6 @@
 
 namespace {
 
-// The filtered box when the box filter holds one, else this frame's raw
-// detection, else none (every feature of that image static).
-std::optional<vimot::frontend::Box> box_of(const vimot::target_box_t& m) {
-  const double* b = m.filtered_valid ? m.filtered_box : (m.raw_valid ? m.raw_box : nullptr);
-  if (b == nullptr) return std::nullopt;
-  return vimot::frontend::Box{b[0], b[1], b[2], b[3]};
-}
-
 int run(int argc, const char* const* argv) {
   vimot::Process process("feature_tracker",
                          "Visual front end: CAM_LEFT / CAM_RIGHT images (+ target boxes) in, FEATURES out.\n"
@@ -48,7 +40,7 @@ int run(int argc, const char* const* argv) {
   }
   process.subscribe<vimot::target_box_t>(
       process.channel("target_box", "TARGET_BOX"),
-      [&](const vimot::target_box_t& m) { node.on_box(m.camera_id, m.utime, box_of(m)); });
+      [&](const vimot::target_box_t& m) { node.on_box(m.camera_id, m.utime, vimot::box_of(m)); });
   const int status = process.run();
   node.flush();
   vimot::log_info("tracked ", node.frames_tracked(), " frames, dropped ", node.images_dropped(), " images, ",

@@ -5,6 +5,10 @@
 
 namespace vimot {
 
+namespace {
+constexpr std::size_t kMaxPendingBoxes = 64;  // 3 s at 20 Hz
+}  // namespace
+
 ObjectTrackerNode::ObjectTrackerNode(const ObjectTrackerOptions& options, PoseCallback on_pose,
                                      EventCallback on_event)
     : tracker_(options), on_pose_(std::move(on_pose)), on_event_(std::move(on_event)) {}
@@ -13,9 +17,19 @@ void ObjectTrackerNode::say(NodeEvent::Kind kind, const std::string& message) {
   if (on_event_) on_event_(NodeEvent{kind, message});
 }
 
+void ObjectTrackerNode::on_box(int64_t utime, const BoundingBox2d& box) {
+  boxes_[utime] = box;
+  // Boxes of frames that never come (e.g. a frame dropped upstream).
+  while (boxes_.size() > kMaxPendingBoxes) boxes_.erase(boxes_.begin());
+}
+
 void ObjectTrackerNode::on_frame(const CameraFrame& frame) {
+  std::optional<BoundingBox2d> box;
+  const auto it = boxes_.find(frame.utime);
+  if (it != boxes_.end()) box = it->second;
+  boxes_.erase(boxes_.begin(), boxes_.upper_bound(frame.utime));
   const ObjectTrackerCounters before = tracker_.counters();
-  const ObjectPoseEstimate estimate = tracker_.process(frame);
+  const ObjectPoseEstimate estimate = tracker_.process(frame, box);
   const ObjectTrackerCounters& after = tracker_.counters();
   if (after.rejected_time_backwards > before.rejected_time_backwards) {
     say(NodeEvent::Kind::kDropped, "FEATURES utime went backwards");

@@ -39,8 +39,12 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   const FeatureTrackerOptions o = FeatureTrackerOptions::from_config(
       Config::from_string(
           "tracker:\n  static: {num_features: 120, klt_window_px: 11, max_track_frames: 20}\n"
+          "  target: {frame_to_frame: klt, min_distance_px: 4}\n"
           "  ransac: {threshold_px: 0.5}\n"),
       "tracker");
+  CHECK(o.target.klt());
+  CHECK(o.target.min_distance_px == 4.0);
+  CHECK_FALSE(FeatureTrackerOptions().target.klt());
   CHECK(o.static_tracks.num_features == 120);
   CHECK(o.static_tracks.max_track_frames == 20);
   CHECK(o.static_tracks.box_margin_px() == 5);
@@ -54,4 +58,6 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   CHECK_THAT(error_of("tracker:\n  ransac: {min_points: 7}\n"), Catch::Contains("min_points"));
   CHECK_THAT(error_of("tracker:\n  static: {max_track_frames: -1}\n"), Catch::Contains("max_track_frames"));
   CHECK_THAT(error_of("tracker:\n  target: {match_ratio: 1.5}\n"), Catch::Contains("match_ratio"));
+  CHECK_THAT(error_of("tracker:\n  target: {frame_to_frame: lk}\n"), Catch::Contains("frame_to_frame"));
+  CHECK_THAT(error_of("tracker:\n  target: {min_distance_px: -1}\n"), Catch::Contains("min_distance_px"));
 }

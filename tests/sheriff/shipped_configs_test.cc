@@ -25,7 +25,8 @@ std::string source_path(const std::string& relative) { return std::string(VIMOT_
 // here fails.
 const std::set<std::string> kChecked = {"sim_demo.pmd",    "sim_mono.pmd",      "euroc.pmd",
                                         "sim_pixels.pmd",  "two_hosts.pmd",     "live_stereo.pmd",
-                                        "live_mono.pmd",   "log_playback.pmd",  "two_hosts_live.pmd"};
+                                        "live_mono.pmd",   "log_playback.pmd",  "two_hosts_live.pmd",
+                                        "sim_mono_pixels.pmd"};
 
 void check_config(const std::string& pmd, const std::vector<std::string>& expected_commands,
                   const std::vector<std::string>& config_files) {
@@ -72,6 +73,8 @@ TEST_CASE("shipped sheriff configs parse") {
                 "segmenter_mono.yaml", "mask_filter_mono.yaml", "imu_mip.yaml", "camera_mono.yaml"});
   // The estimator configs come from the environment (simulated or real log).
   check_config("log_playback.pmd", {"logger", "vins", "target_filter", "player"}, {});
+  check_config("sim_mono_pixels.pmd", {"logger", "vins", "object_tracker", "scale_estimator", "feature_tracker", "sim"},
+               {"vins_mono.yaml", "object_tracker.yaml", "scale_estimator.yaml", "feature_tracker_sim_mono.yaml"});
 }
 
 TEST_CASE("the two-host layout puts each command on its machine") {
