@@ -136,8 +136,9 @@ std::optional<AnchorPatch::Alignment> AnchorPatch::align(const cv::Mat& image, c
     a = a * step_inverse;
     p += moved;
     if (!p.allFinite() || !a.allFinite()) return std::nullopt;
-    // The patch's centre and its corners (the affine part times the half
-    // width) both moved less than epsilon.
+    // Converged when the patch's centre and its corners (the change of the
+    // affine part, a · step being the previous one, times the half width)
+    // moved less than epsilon.
     const float corner_motion = (a - a * step).cwiseAbs().maxCoeff() * static_cast<float>(half_);
     if (moved.norm() < epsilon && corner_motion < epsilon) {
       return Alignment{cv::Point2f(p.x(), p.y()), a, zncc};
