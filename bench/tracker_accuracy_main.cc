@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -68,8 +69,8 @@ int run(int argc, const char* const* argv) {
   row("static, left (temporal)", e, [&](const E& x) { return stat(x) && x.camera_id == 0; });
   row("static, right (stereo)", e, [&](const E& x) { return stat(x) && x.camera_id == 1; });
   row("static, right, age 0", e, [&](const E& x) { return stat(x) && x.camera_id == 1 && x.age == 0; });
-  const int ages[] = {1, 2, 6, 21, 51, 1 << 30};
-  for (int a = 0; a + 1 < 6; ++a) {
+  const int ages[] = {1, 2, 6, 21, 51, 101, 201, 1 << 30};
+  for (std::size_t a = 0; a + 1 < std::size(ages); ++a) {
     const std::string name = "static, left, age " + std::to_string(ages[a]) + "-" +
                              (ages[a + 1] == (1 << 30) ? std::string("") : std::to_string(ages[a + 1] - 1));
     row(name, e, [&](const E& x) { return stat(x) && x.camera_id == 0 && x.age >= ages[a] && x.age < ages[a + 1]; });

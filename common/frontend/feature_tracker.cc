@@ -1,6 +1,7 @@
 #include "common/frontend/feature_tracker.h"
 
 #include <algorithm>
+#include <Eigen/SVD>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -122,9 +123,51 @@ std::vector<FeatureTracker::Point> FeatureTracker::klt(const std::vector<cv::Mat
     p.id = points[i].id;
     p.pixel = to[i];
     p.born_frame = points[i].born_frame;
+    p.anchor = points[i].anchor;
+    p.affine = points[i].affine;
     if (normalize(to_cam, &p)) out.push_back(p);
   }
   return out;
+}
+
+bool FeatureTracker::anchor(int cam, Point* p) const {
+  std::optional<AnchorPatch> patch = AnchorPatch::take(pyramid_[static_cast<std::size_t>(cam)][0], p->pixel,
+                                                       options_.static_tracks.klt_window_px);
+  if (!patch) return false;
+  p->anchor = std::make_shared<const AnchorPatch>(std::move(*patch));
+  p->affine = Eigen::Matrix2f::Identity();
+  return true;
+}
+
+void FeatureTracker::align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const {
+  const StaticTrackOptions& o = options_.static_tracks;
+  const cv::Mat& image = pyramid_[static_cast<std::size_t>(cam)][0];
+  const auto max_correction2 = static_cast<float>(o.anchor_max_correction_px * o.anchor_max_correction_px);
+  std::vector<Point> kept;
+  kept.reserve(points->size());
+  for (Point& p : *points) {
+    const std::optional<AnchorPatch::Alignment> a = p.anchor->align(
+        image, p.pixel, p.affine, o.klt_max_iterations, static_cast<float>(o.klt_epsilon));
+    if (!a || a->zncc < o.anchor_min_zncc) continue;
+    const cv::Point2f correction = a->pixel - p.pixel;
+    if (correction.dot(correction) > max_correction2 || !usable(cam, a->pixel, box)) continue;
+    Point q = p;
+    q.pixel = a->pixel;
+    q.affine = a->affine;
+    if (!normalize(cam, &q)) continue;
+    const Eigen::Vector2f scale = Eigen::JacobiSVD<Eigen::Matrix2f>(q.affine).singularValues();
+    const auto limit = static_cast<float>(o.anchor_max_scale);
+    // Far from the anchor's scale the affine model no longer describes the
+    // patch (perspective, resampling): the current patch, at the aligned
+    // position, becomes the anchor. The error made so far is kept, but it
+    // grows only at these rare steps, not every frame.
+    if (scale(0) > limit || scale(1) < 1.0f / limit) {
+      Point fresh = q;
+      if (anchor(cam, &fresh)) q = fresh;
+    }
+    kept.push_back(std::move(q));
+  }
+  points->swap(kept);
 }
 
 void FeatureTracker::track_static_temporal(int cam, const std::optional<Box>& box) {
@@ -139,6 +182,7 @@ void FeatureTracker::track_static_temporal(int cam, const std::optional<Box>& bo
                                  [&](const Point& p) { return frame_index_ - p.born_frame >= max_age; }),
                   tracked.end());
   }
+  if (options_.static_tracks.anchor_align) align_to_anchors(cam, box, &tracked);
   std::vector<Eigen::Vector2d> a, b;
   for (const Point& p : tracked) {
     a.push_back(before.at(p.id));
@@ -161,6 +205,7 @@ void FeatureTracker::detect_static(const std::optional<Box>& box) {
     Point p;
     p.pixel = px;
     if (!normalize(0, &p)) continue;
+    if (options_.static_tracks.anchor_align && !anchor(0, &p)) continue;
     p.id = next_id_++;
     p.born_frame = frame_index_;
     left.push_back(p);
@@ -182,7 +227,10 @@ void FeatureTracker::match_static_stereo(const std::optional<Box>& box_right) {
     if (p.id >= first_new_id_) fresh.push_back(p);
   }
   std::vector<Point> found = klt(pyramid_[0], 1, pyramid_[1], fresh, box_right);
-  right.insert(right.end(), found.begin(), found.end());
+  for (Point& p : found) {
+    // A right track is anchored in the right image where it was matched.
+    if (!options_.static_tracks.anchor_align || anchor(1, &p)) right.push_back(std::move(p));
+  }
 
   // One RANSAC over every stereo pair, continuing and new.
   std::vector<std::size_t> right_index;

@@ -17,12 +17,14 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <random>
 #include <vector>
 
 #include "common/camera/camera_model.h"
+#include "common/frontend/anchor_patch.h"
 #include "common/frontend/box.h"
 #include "common/frontend/epipolar_ransac.h"
 #include "common/frontend/orb_features.h"
@@ -70,6 +72,10 @@ class FeatureTracker {
     cv::Point2f pixel;
     Eigen::Vector2d normalized{Eigen::Vector2d::Zero()};
     int64_t born_frame{0};  // frame index of the track's first corner
+    // static.anchor_align: the patch of the track's anchor image and its
+    // warp into the current image (shared: a Point is copied each frame).
+    std::shared_ptr<const AnchorPatch> anchor;
+    Eigen::Matrix2f affine{Eigen::Matrix2f::Identity()};
   };
   struct TargetPoint {
     Point point;
@@ -81,6 +87,12 @@ class FeatureTracker {
   bool normalize(int cam, Point* p) const;
   bool usable(int cam, const cv::Point2f& px, const std::optional<Box>& box) const;
   void track_static_temporal(int cam, const std::optional<Box>& box);
+  /// static.anchor_align: takes `p`'s anchor patch in camera `cam`'s current
+  /// image; false if it cannot be taken (edge of the image, too little texture).
+  bool anchor(int cam, Point* p) const;
+  /// static.anchor_align: refines the KLT positions against the anchors,
+  /// drops the tracks whose anchor no longer matches, re-anchors deformed ones.
+  void align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const;
   void detect_static(const std::optional<Box>& box);
   void match_static_stereo(const std::optional<Box>& box_right);
   void track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes);

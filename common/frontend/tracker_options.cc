@@ -44,6 +44,9 @@ void StaticTrackOptions::validate() const {
   require(klt_max_iterations > 0, "static.klt_max_iterations must be > 0");
   require(klt_epsilon > 0.0, "static.klt_epsilon must be > 0");
   require(max_track_frames >= 0, "static.max_track_frames must be >= 0");
+  require(anchor_min_zncc >= -1.0 && anchor_min_zncc <= 1.0, "static.anchor_min_zncc must be in [-1, 1]");
+  require(anchor_max_correction_px > 0.0, "static.anchor_max_correction_px must be > 0");
+  require(anchor_max_scale > 1.0, "static.anchor_max_scale must be > 1");
 }
 
 void TargetTrackOptions::validate() const {
@@ -82,7 +85,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   only_keys(cfg, s + "static",
             {"equalize", "num_features", "grid_cols", "grid_rows", "fast_threshold", "min_distance_px", "border_px",
              "klt_window_px", "klt_pyramid_levels", "klt_max_iterations", "klt_epsilon",
-             "max_track_frames"});
+             "max_track_frames", "anchor_align", "anchor_min_zncc", "anchor_max_correction_px", "anchor_max_scale"});
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
              "max_motion_px", "loop_closure_max_hamming", "max_stored_points", "frame_to_frame", "min_distance_px"});
@@ -101,6 +104,10 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "static.klt_max_iterations", &st.klt_max_iterations);
   read(cfg, s + "static.klt_epsilon", &st.klt_epsilon);
   read(cfg, s + "static.max_track_frames", &st.max_track_frames);
+  read(cfg, s + "static.anchor_align", &st.anchor_align);
+  read(cfg, s + "static.anchor_min_zncc", &st.anchor_min_zncc);
+  read(cfg, s + "static.anchor_max_correction_px", &st.anchor_max_correction_px);
+  read(cfg, s + "static.anchor_max_scale", &st.anchor_max_scale);
 
   TargetTrackOptions& t = o.target;
   read(cfg, s + "target.num_features", &t.num_features);

@@ -3,7 +3,8 @@
 // place. Keys under the section (config/feature_tracker.yaml, `tracker:`):
 //   static:  equalize, num_features, grid_cols, grid_rows, fast_threshold,
 //            min_distance_px, border_px, klt_window_px, klt_pyramid_levels,
-//            klt_max_iterations, klt_epsilon
+//            klt_max_iterations, klt_epsilon, max_track_frames, anchor_align,
+//            anchor_min_zncc, anchor_max_correction_px, anchor_max_scale
 //   target:  num_features, orb_fast_threshold, orb_levels, orb_scale_factor,
 //            max_hamming, match_ratio, max_motion_px, loop_closure_max_hamming,
 //            max_stored_points, frame_to_frame, min_distance_px
@@ -37,6 +38,17 @@ struct StaticTrackOptions {
   // re-detected under a new id): KLT's error grows with a track's age
   // (docs/feature_tracker.md). 0 = no limit.
   int max_track_frames{0};
+  // Anchored tracks (anchor_patch.h): each frame-to-frame KLT position is
+  // refined by aligning the patch of the track's anchor image (affine warp,
+  // gain/offset) so the error does not accumulate. A track whose aligned
+  // patch correlates below anchor_min_zncc, or whose alignment moves the
+  // KLT position by more than anchor_max_correction_px, ends; one whose
+  // warp has scaled the patch beyond anchor_max_scale (either way) takes
+  // its current patch as the new anchor.
+  bool anchor_align{false};
+  double anchor_min_zncc{0.8};
+  double anchor_max_correction_px{2.0};
+  double anchor_max_scale{1.3};
   /// Static features keep this far (px) from the target box: a KLT window
   /// overlapping the target follows the target's motion, not the room's.
   int box_margin_px() const { return klt_window_px / 2; }

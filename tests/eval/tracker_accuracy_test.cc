@@ -1,6 +1,6 @@
 // The feature tracker on rendered stereo pairs against the true
 // correspondences (common/eval/tracker_accuracy.h): the shipped rendered
-// configs (config/sim_paper.yaml, config/feature_tracker_sim.yaml), 3 s.
+// configs (config/sim_paper.yaml, config/feature_tracker_sim.yaml), 3-6 s.
 // The bounds are the noise model the estimator assumes (config/vins.yaml
 // sigma_px = 1 px per axis, white): the error norm is then Rayleigh, with
 // median 1.18 px, 95th percentile 2.45 px and P(> 3 px) = exp(-4.5) = 1.1 %.
@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "common/config/config.h"
 #include "common/eval/tracker_accuracy.h"
@@ -86,6 +88,47 @@ TEST_CASE("Static tracks on rendered pairs stay within the estimator's pixel noi
   INFO("stereo, new: " << st.count << " observations, median " << st.median_px << " px");
   REQUIRE(st.count > 100);
   CHECK(st.median_px < 0.5);
+}
+
+TEST_CASE("Anchored static tracks do not drift with age on rendered frames", "[eval][tracker_accuracy]") {
+  // The shipped rendered config aligns each track to its anchor patch; the
+  // same run without it is frame-to-frame KLT, whose error accumulates.
+  const sim::Simulator sim(paper_config(6.0));
+  frontend::FeatureTrackerOptions anchored = tracker_options();
+  REQUIRE(anchored.static_tracks.anchor_align);
+  frontend::FeatureTrackerOptions plain = anchored;
+  plain.static_tracks.anchor_align = false;
+  auto left_by_age = [&](const frontend::FeatureTrackerOptions& options, int from, int to) {
+    eval::PixelFrontEnd front(sim, options);
+    std::vector<eval::ObservationError> young, old;
+    for (const eval::ObservationError& e : eval::tracker_errors(sim, &front, sim.camera_frame_count())) {
+      if (e.is_target || e.camera_id != 0) continue;
+      if (e.age >= 1 && e.age <= 5) young.push_back(e);
+      if (e.age >= from && e.age <= to) old.push_back(e);
+    }
+    return std::make_pair(eval::summarise(young), eval::summarise(old));
+  };
+  // Tracks older than 20 frames, up to the config's cap or the run's end.
+  const int cap = anchored.static_tracks.max_track_frames;
+  const int last = cap > 0 ? cap - 1 : 60;
+  const auto [a_young, a_old] = left_by_age(anchored, 21, last);
+  const auto [p_young, p_old] = left_by_age(plain, 21, last);
+  INFO("anchored: age 1-5 median " << a_young.median_px << " px, age 21-" << last << " median " << a_old.median_px
+                                   << " px p95 " << a_old.p95_px << " px (" << a_old.count << ")");
+  INFO("frame to frame: age 1-5 median " << p_young.median_px << " px, age 21-" << last << " median "
+                                         << p_old.median_px << " px p95 " << p_old.p95_px << " px (" << p_old.count
+                                         << ")");
+  REQUIRE(a_old.count > 1000);
+  REQUIRE(p_old.count > 1000);
+  // Young tracks: the same (anchoring only corrects what KLT accumulated).
+  CHECK(a_young.median_px <= p_young.median_px);
+  // Old tracks: at least twice as accurate as frame to frame, and within
+  // the estimator's noise model (Rayleigh bounds for σ = 1 px).
+  CHECK(a_old.median_px < 0.5 * p_old.median_px);
+  CHECK(a_old.p95_px < 0.5 * p_old.p95_px);
+  CHECK(a_old.median_px < 1.18);
+  CHECK(a_old.p95_px < 2.45);
+  CHECK(a_old.outlier_fraction < 0.011);
 }
 
 TEST_CASE("summarise: median, nearest-rank p95 and the > 3 px fraction", "[eval][tracker_accuracy]") {

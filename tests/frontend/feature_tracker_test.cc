@@ -88,7 +88,11 @@ TEST_CASE("stereo tracks of a rendered plane match the true correspondences (EuR
   l1.p = Eigen::Vector3d(-0.02, 0.01, -0.02);
   const Pose r0 = right_of(l0, calib[0], calib[1]), r1 = right_of(l1, calib[0], calib[1]);
 
-  FeatureTracker tracker(FeatureTrackerOptions{}, calib);
+  // Frame-to-frame KLT alone, and refined against each track's anchor patch.
+  FeatureTrackerOptions options;
+  options.static_tracks.anchor_align = GENERATE(false, true);
+  INFO("anchor_align " << options.static_tracks.anchor_align);
+  FeatureTracker tracker(options, calib);
   const CameraFrame f0 =
       tracker.track(1000, plane.render(cam0, l0.R, l0.p), plane.render(cam1, r0.R, r0.p), std::nullopt, std::nullopt);
   const CameraFrame f1 =

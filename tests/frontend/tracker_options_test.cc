@@ -38,7 +38,8 @@ TEST_CASE("config/feature_tracker.yaml gives the built-in defaults") {
 TEST_CASE("tracker options: values are read, unknown keys and bad values refused") {
   const FeatureTrackerOptions o = FeatureTrackerOptions::from_config(
       Config::from_string(
-          "tracker:\n  static: {num_features: 120, klt_window_px: 11, max_track_frames: 20}\n"
+          "tracker:\n  static: {num_features: 120, klt_window_px: 11, max_track_frames: 20, anchor_align: true,\n"
+          "           anchor_min_zncc: 0.7, anchor_max_correction_px: 1.5, anchor_max_scale: 1.5}\n"
           "  target: {frame_to_frame: klt, min_distance_px: 4}\n"
           "  ransac: {threshold_px: 0.5}\n"),
       "tracker");
@@ -47,6 +48,10 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   CHECK_FALSE(FeatureTrackerOptions().target.klt());
   CHECK(o.static_tracks.num_features == 120);
   CHECK(o.static_tracks.max_track_frames == 20);
+  CHECK(o.static_tracks.anchor_align);
+  CHECK(o.static_tracks.anchor_min_zncc == 0.7);
+  CHECK(o.static_tracks.anchor_max_correction_px == 1.5);
+  CHECK(o.static_tracks.anchor_max_scale == 1.5);
   CHECK(o.static_tracks.box_margin_px() == 5);
   CHECK(o.static_tracks.klt_window_px == 11);
   CHECK(o.ransac.threshold_px == 0.5);
@@ -57,6 +62,10 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   CHECK_THAT(error_of("tracker:\n  static: {klt_window_px: 14}\n"), Catch::Contains("klt_window_px"));
   CHECK_THAT(error_of("tracker:\n  ransac: {min_points: 7}\n"), Catch::Contains("min_points"));
   CHECK_THAT(error_of("tracker:\n  static: {max_track_frames: -1}\n"), Catch::Contains("max_track_frames"));
+  CHECK_THAT(error_of("tracker:\n  static: {anchor_min_zncc: 1.5}\n"), Catch::Contains("anchor_min_zncc"));
+  CHECK_THAT(error_of("tracker:\n  static: {anchor_max_correction_px: 0}\n"),
+             Catch::Contains("anchor_max_correction_px"));
+  CHECK_THAT(error_of("tracker:\n  static: {anchor_max_scale: 1.0}\n"), Catch::Contains("anchor_max_scale"));
   CHECK_THAT(error_of("tracker:\n  target: {match_ratio: 1.5}\n"), Catch::Contains("match_ratio"));
   CHECK_THAT(error_of("tracker:\n  target: {frame_to_frame: lk}\n"), Catch::Contains("frame_to_frame"));
   CHECK_THAT(error_of("tracker:\n  target: {min_distance_px: -1}\n"), Catch::Contains("min_distance_px"));
