@@ -80,7 +80,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     for (const FeatureObservation& o : frame.observations) has_target_obs = has_target_obs || o.is_target;
     if (has_target_obs && !target_seen) first_target_utime = frame.utime;
     target_seen = target_seen || has_target_obs;
-    const int64_t updates_before = filter ? filter->stats().updates : 0;
+    const int64_t used_before = filter ? filter->stats().obs_used : 0;
     const FrameStatus st = est.feed_camera(frame);
     if (progress) progress(static_cast<double>(frames_seen) / static_cast<double>(frames_total));
     if (st == FrameStatus::kDiverged) {
@@ -93,7 +93,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     gap = has_target_obs ? 0 : gap + 1;
     r.longest_gap_frames = std::max(r.longest_gap_frames, gap);
     r.frames_with_target_obs += has_target_obs ? 1 : 0;
-    if (filter) r.frames_with_target_update += filter->stats().updates > updates_before ? 1 : 0;
+    if (filter) r.frames_with_target_update += filter->stats().obs_used > used_before ? 1 : 0;
     try {
       e_imu.add(error_of(estimator::nav_state_of(est, true), truth));
       if (filter && filter->initialized() && truth.has_target) {
@@ -147,6 +147,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   r.target_in_world = e_tg.summary();
   r.imu = e_imu.summary();
   r.frames_processed = est.frames_processed();
+  if (filter) r.target_stats = filter->stats();
   if (filter && !r.diverged && filter_options->mode != TargetUpdateMode::kOff && !r.target_initialized) {
     r.diverged = true;
     r.divergence_reason = "target never initialised";
@@ -391,6 +392,14 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
         j.field("frames_with_target_update", r.frames_with_target_update);
         j.field("longest_gap_frames", r.longest_gap_frames).field("target_max_error_m", r.target_max_error_m);
         j.field("target_init_s", r.target_init_s);
+        j.end_object();
+        const target::TargetUpdateStats& ts = r.target_stats;
+        j.key("target_updates").begin_object();
+        j.field("obs_received", ts.obs_received).field("obs_used", ts.obs_used);
+        j.field("tracks_used", ts.tracks_used).field("rejected_short", ts.rejected_short);
+        j.field("rejected_triangulation", ts.rejected_triangulation).field("rejected_chi2", ts.rejected_chi2);
+        j.field("points_initialized", ts.points_initialized).field("points_rejected_init", ts.points_rejected_init);
+        j.field("point_updates", ts.point_updates).field("points_rejected_chi2", ts.points_rejected_chi2);
         j.end_object();
       }
       j.key("target_in_imu");

@@ -65,8 +65,8 @@ struct TargetRunResult {
   /// Whether the target was tracked through the run, counted over the
   /// evaluated frames (imu.count: processed, with truth, from the first frame
   /// with target observations on): with a target estimate (target_in_imu.count),
-  /// with target observations, with a target update applied (in-state
-  /// points or tracks); the longest run of evaluated frames without target
+  /// with target observations, with target observations used in an update
+  /// (in-state points, new points or tracks); the longest run of evaluated frames without target
   /// observations; the largest target-in-IMU position error (a target lost
   /// by the filter shows there, not in the frame counts: it never drops an
   /// initialised target).
@@ -75,6 +75,9 @@ struct TargetRunResult {
   int64_t longest_gap_frames{0};
   double target_max_error_m{0.0};
   double target_init_s{0.0};  // s from the first frame with target observations to the target's start
+  /// The filter's counters at the end (which target tracks and points were
+  /// used or rejected, and why).
+  target::TargetUpdateStats target_stats;
   bool diverged{false};
   std::string divergence_reason;
   double wall_s{0.0};
