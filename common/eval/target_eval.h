@@ -63,10 +63,11 @@ struct TargetRunResult {
   TargetFrameTransform target_frame;
   int64_t frames_processed{0};
   /// Whether the target was tracked through the run, counted over the
-  /// evaluated frames (imu.count: processed, with truth, from the first frame
-  /// with target observations on): with a target estimate (target_in_imu.count),
-  /// with target observations, with target observations used in an update
-  /// (in-state points, new points or tracks); the longest run of evaluated frames without target
+  /// evaluated frames (imu.count: processed, with truth, from the first
+  /// frame with target observations on): with a target estimate
+  /// (target_in_imu.count), with target observations, with target
+  /// observations used in an update (in-state points, new points or
+  /// tracks); the longest run of evaluated frames without target
   /// observations; the largest target-in-IMU position error (a target lost
   /// by the filter shows there, not in the frame counts: it never drops an
   /// initialised target).
