@@ -18,9 +18,9 @@
 #    object pose error in the world and that of the object motion filter.
 #  - pixels: sheriff_configs/sim_pixels.pmd (simulator rendering images,
 #    feature tracker with the true target box, vins, target filter,
-#    lcm-logger): VIO accuracy of the LCM run against the same seed's
-#    offline run from pixels (vimot-vio-eval --pixels) and next to the
-#    feature-level run of that seed.
+#    lcm-logger): VIO and target accuracy of the LCM run against the same
+#    seed's offline run from pixels (vimot-vio-eval / vimot-target-eval
+#    --pixels) and next to the feature-level runs of that seed.
 #  - mono-pixels: sheriff_configs/sim_mono_pixels.pmd (simulator rendering
 #    cam0, feature tracker with the true target box, vins, object tracker,
 #    scale estimator, lcm-logger): VIO accuracy and the scale figures of the
@@ -150,8 +150,6 @@ if [ $pipeline = pixels ]; then
     --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
     --duration "$VIMOT_DURATION" --perturb-seed "${perturb_seed:-0}" --quiet > "$out/offline_features.txt" 2>&1 || true
   grep -E '^(seed|mean|pred)' "$out/offline_features.txt" | sed 's/^/   /'
-  echo "== log (images left out): $VIMOT_LOG"
-  finish
 fi
 if [ $pipeline = mono_pixels ]; then
   echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run from pixels:"
@@ -196,11 +194,16 @@ target_key() { sed -n "s/^  $1: *\([a-z0-9.]*\).*/\1/p" "$target_cfg" | head -n 
 # init.mode features: the filter's own target frame, compared through the fixed transform.
 own_frame=""
 if sed -n '/^  init:/,/^  [a-z_]*:/p' "$target_cfg" | grep -q '^    mode: *features'; then own_frame="--own-target-frame"; fi
-"$VIMOT_BIN/vimot-target-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
-  --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-config "$target_cfg" \
-  --modes "$(target_key mode)" --representations "$(target_key representation)" \
-  --sigmas "$(target_key sigma_t)" --no-vio-only --runs 1 --first-seed "$VIMOT_SEED" \
-  --perturb-seed "${perturb_seed:-0}" --out "$out/offline_target" --quiet > "$out/offline_target.txt" 2>&1 || true
+target_eval() {  # the offline target run of this seed; $1: output name, then extra options
+  local name=$1
+  shift
+  "$VIMOT_BIN/vimot-target-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+    --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-config "$target_cfg" \
+    --modes "$(target_key mode)" --representations "$(target_key representation)" \
+    --sigmas "$(target_key sigma_t)" --no-vio-only --runs 1 --first-seed "$VIMOT_SEED" \
+    --perturb-seed "${perturb_seed:-0}" "$@" --out "$out/$name" --quiet > "$out/$name.txt" 2>&1 || true
+}
+target_eval offline_target "${offline_args[@]}"
 target_status=0
 "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE $own_frame \
   --compare-target "$out/offline_target/summary.json" --tolerance 1e-6 > "$out/lcm_vs_offline_target.txt" 2>&1 \
@@ -211,6 +214,15 @@ if [ "$target_status" -ne 0 ] && [ "$lcm_vs_offline" -eq 0 ]; then
   cat "$out/lcm_vs_offline_target.txt" >> "$out/lcm_vs_offline.txt"
 fi
 echo "   (offline target run: $out/offline_target.txt)"
+if [ $pipeline = pixels ]; then
+  echo "== the same seed's target at feature level (the simulator's own tracks, no pixels), offline:"
+  target_eval offline_target_features --duration "$VIMOT_DURATION"
+  grep -E '^(\| (σ_t|[0-9])|Table|Average|  .*target estimate on)' "$out/offline_target_features.txt" \
+    | sed 's/^ */   /'
+  echo "   (from pixels: $out/offline_target.txt)"
+  echo "== log (images left out): $VIMOT_LOG"
+  finish
+fi
 echo "== log: $VIMOT_LOG"
 echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
 finish

@@ -13,11 +13,13 @@
 #include "common/estimator/nav_state_of.h"
 #include "common/estimator/state_helper.h"
 #include "common/eval/json.h"
+#include "common/eval/pixel_frontend.h"
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/sim/simulator.h"
 #include "common/target/target_conversion.h"
 #include "common/target/target_filter_config.h"
+#include "common/time/utime.h"
 
 namespace vimot {
 namespace eval {
@@ -38,11 +40,13 @@ target::TargetFilterOptions target_filter_options(const Config& config) {
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                                   const std::optional<target::TargetFilterOptions>& filter_options,
                                   uint64_t perturb_seed, const std::function<void(double)>& progress,
-                                  bool keep_samples) {
+                                  bool keep_samples, const std::optional<frontend::FeatureTrackerOptions>& pixels) {
   const auto wall_start = std::chrono::steady_clock::now();
   sim::SimConfig cfg = sim_config;
   cfg.ground_truth_events = true;
   sim::Simulator sim(cfg);
+  std::optional<PixelFrontEnd> pixel_frontend;
+  if (pixels) pixel_frontend.emplace(sim, *pixels);
   VioEstimator est(options);
   TargetRunResult r;
   r.sim_seed = cfg.seed;
@@ -62,7 +66,9 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   GroundTruth truth;
   bool have_truth = false;
   bool target_seen = false;
+  int64_t first_target_utime = 0;
   int64_t frames_seen = 0;
+  int64_t gap = 0;
   auto on_truth = [&](const GroundTruth& gt) {
     truth = gt;
     have_truth = true;
@@ -70,7 +76,11 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   };
   play_simulator(sim, est, on_truth, [&](const CameraFrame& frame) {
     ++frames_seen;
-    for (const FeatureObservation& o : frame.observations) target_seen = target_seen || o.is_target;
+    bool has_target_obs = false;
+    for (const FeatureObservation& o : frame.observations) has_target_obs = has_target_obs || o.is_target;
+    if (has_target_obs && !target_seen) first_target_utime = frame.utime;
+    target_seen = target_seen || has_target_obs;
+    const int64_t used_before = filter ? filter->stats().obs_used : 0;
     const FrameStatus st = est.feed_camera(frame);
     if (progress) progress(static_cast<double>(frames_seen) / static_cast<double>(frames_total));
     if (st == FrameStatus::kDiverged) {
@@ -80,9 +90,14 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     }
     if (st != FrameStatus::kProcessed) return true;
     if (!have_truth || truth.utime != frame.utime || !target_seen) return true;
+    gap = has_target_obs ? 0 : gap + 1;
+    r.longest_gap_frames = std::max(r.longest_gap_frames, gap);
+    r.frames_with_target_obs += has_target_obs ? 1 : 0;
+    if (filter) r.frames_with_target_update += filter->stats().obs_used > used_before ? 1 : 0;
     try {
       e_imu.add(error_of(estimator::nav_state_of(est, true), truth));
       if (filter && filter->initialized() && truth.has_target) {
+        if (!r.target_initialized) r.target_init_s = utime_to_seconds(frame.utime - first_target_utime);
         r.target_initialized = true;
         const estimator::State& s = est.state();
         const target::PoseValue ip = target::imu_pose(est.imu_value());
@@ -114,6 +129,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
                                              P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3));
         e_ti.add(ti);
         e_tg.add(tg);
+        r.target_max_error_m = std::max(r.target_max_error_m, ti.err_p.norm());
         if (keep_samples) {
           r.target_in_imu_samples.push_back(ti);
           r.target_in_world_samples.push_back(tg);
@@ -125,12 +141,13 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
       return false;
     }
     return true;
-  });
+  }, pixel_frontend ? &*pixel_frontend : nullptr);
   if (progress) progress(1.0);
   r.target_in_imu = e_ti.summary();
   r.target_in_world = e_tg.summary();
   r.imu = e_imu.summary();
   r.frames_processed = est.frames_processed();
+  if (filter) r.target_stats = filter->stats();
   if (filter && !r.diverged && filter_options->mode != TargetUpdateMode::kOff && !r.target_initialized) {
     r.diverged = true;
     r.divergence_reason = "target never initialised";
@@ -197,7 +214,7 @@ std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estim
         if (!c.vio_only) f = c.filter;
         c.runs[static_cast<std::size_t>(i)] =
             run_target_on_sim(cfg, options, f, o.fixed_perturb_seed.value_or(estimator::perturb_seed_for_run(seed)), fr,
-                              o.keep_samples);
+                              o.keep_samples, o.pixels);
       },
       progress);
   return cells;
@@ -339,7 +356,7 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
   j.begin_object();
   j.field("tool", "vimot-target-eval").field("sim_config", sim_config).field("vins_config", vins_config);
   j.field("target_config", target_config).field("runs", o.runs).field("first_seed", o.first_seed);
-  j.field("threads", o.threads).field("wall_s", wall_s);
+  j.field("threads", o.threads).field("wall_s", wall_s).field("from_pixels", o.pixels.has_value());
   j.key("cells").begin_array();
   for (const TargetCell& c : cells) {
     const TargetCellSummary s = summarize(c);
@@ -368,6 +385,21 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
         j.key("p_TestInT").begin_array();
         for (int k = 0; k < 3; ++k) j.value(r.target_frame.p_TestInT(k));
         j.end_array();
+        j.end_object();
+        j.key("tracking").begin_object();
+        j.field("frames_evaluated", r.imu.count).field("frames_with_target", r.target_in_imu.count);
+        j.field("frames_with_target_obs", r.frames_with_target_obs);
+        j.field("frames_with_target_update", r.frames_with_target_update);
+        j.field("longest_gap_frames", r.longest_gap_frames).field("target_max_error_m", r.target_max_error_m);
+        j.field("target_init_s", r.target_init_s);
+        j.end_object();
+        const target::TargetUpdateStats& ts = r.target_stats;
+        j.key("target_updates").begin_object();
+        j.field("obs_received", ts.obs_received).field("obs_used", ts.obs_used);
+        j.field("tracks_used", ts.tracks_used).field("rejected_short", ts.rejected_short);
+        j.field("rejected_triangulation", ts.rejected_triangulation).field("rejected_chi2", ts.rejected_chi2);
+        j.field("points_initialized", ts.points_initialized).field("points_rejected_init", ts.points_rejected_init);
+        j.field("point_updates", ts.point_updates).field("points_rejected_chi2", ts.points_rejected_chi2);
         j.end_object();
       }
       j.key("target_in_imu");
@@ -413,6 +445,14 @@ std::vector<TargetCell> read_target_cells(const std::string& summary_json) {
         run.target_in_world = summary_from_json(r.at("target_in_world"));
         run.imu = summary_from_json(r.at("imu"));
         run.wall_s = r.at("wall_s").number();
+        if (r.has("tracking")) {  // (files written before it was added have none)
+          const JsonValue& t = r.at("tracking");
+          run.frames_with_target_obs = static_cast<int64_t>(t.at("frames_with_target_obs").number());
+          run.frames_with_target_update = static_cast<int64_t>(t.at("frames_with_target_update").number());
+          run.longest_gap_frames = static_cast<int64_t>(t.at("longest_gap_frames").number());
+          run.target_max_error_m = t.at("target_max_error_m").number();
+          run.target_init_s = t.at("target_init_s").number();
+        }
         cell.runs.push_back(run);
       }
       out.push_back(std::move(cell));

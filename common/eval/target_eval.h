@@ -27,6 +27,9 @@
 //    vimot-vio-eval.
 // RMSE and mean NEES per run (TrajectoryErrors); a cell of the sweep
 // averages its runs (diverged runs are left out and counted).
+// From pixels (`pixels` set): the frames are the features PixelFrontEnd
+// tracks in the rendered images (true box), as vimot-vio-eval --pixels; the
+// truth and the samples are the same.
 
 #include <cstdint>
 #include <optional>
@@ -37,6 +40,7 @@
 #include "common/eval/metrics.h"
 #include "common/eval/sim_runner.h"
 #include "common/eval/target_frame.h"
+#include "common/frontend/tracker_options.h"
 #include "common/target/target_filter.h"
 
 namespace vimot {
@@ -58,6 +62,23 @@ struct TargetRunResult {
   /// (init mode features); identity for the start from the truth.
   TargetFrameTransform target_frame;
   int64_t frames_processed{0};
+  /// Whether the target was tracked through the run, counted over the
+  /// evaluated frames (imu.count: processed, with truth, from the first
+  /// frame with target observations on): with a target estimate
+  /// (target_in_imu.count), with target observations, with target
+  /// observations used in an update (in-state points, new points or
+  /// tracks); the longest run of evaluated frames without target
+  /// observations; the largest target-in-IMU position error (a target lost
+  /// by the filter shows there, not in the frame counts: it never drops an
+  /// initialised target).
+  int64_t frames_with_target_obs{0};
+  int64_t frames_with_target_update{0};
+  int64_t longest_gap_frames{0};
+  double target_max_error_m{0.0};
+  double target_init_s{0.0};  // s from the first frame with target observations to the target's start
+  /// The filter's counters at the end (which target tracks and points were
+  /// used or rejected, and why).
+  target::TargetUpdateStats target_stats;
   bool diverged{false};
   std::string divergence_reason;
   double wall_s{0.0};
@@ -68,10 +89,12 @@ struct TargetRunResult {
 
 /// One run on `sim_config` (its seed and duration); filter == nullopt: VIO
 /// only. `progress` gets the fraction of camera frames done. keep_samples:
-/// also return the per-frame target errors.
+/// also return the per-frame target errors. pixels: frames from the rendered
+/// images through the feature tracker with these options.
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                                   const std::optional<target::TargetFilterOptions>& filter, uint64_t perturb_seed,
-                                  const std::function<void(double)>& progress = {}, bool keep_samples = false);
+                                  const std::function<void(double)>& progress = {}, bool keep_samples = false,
+                                  const std::optional<frontend::FeatureTrackerOptions>& pixels = std::nullopt);
 
 /// One cell of the sweep: a filter configuration (or VIO only) × runs.
 struct TargetCell {
@@ -103,6 +126,8 @@ struct TargetSweepOptions {
   /// Perturbation seed of every run instead of perturb_seed_for_run (0 =
   /// start at the truth), e.g. the vins config's, to reproduce an LCM run.
   std::optional<uint64_t> fixed_perturb_seed;
+  /// Frames from pixels (run_target_on_sim's `pixels`).
+  std::optional<frontend::FeatureTrackerOptions> pixels;
 };
 
 /// Every cell (VIO only first, then modes × representations × sigmas in

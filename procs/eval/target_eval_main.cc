@@ -3,12 +3,15 @@
 // simulator, offline (no LCM): joint robot + target filter (EKF / SKF,
 // global / local) and the VIO-only reference, N Monte-Carlo runs per cell.
 // Run i of every cell uses simulator seed first_seed + i and the perturbed
-// IMU start of vimot-vio-eval; the target starts from the truth.
-#include <optional>
+// IMU start of vimot-vio-eval; the target starts from its own features (or
+// the truth: --target-init). --pixels: the frames come from the rendered
+// images through the feature tracker, as vimot-vio-eval --pixels.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -78,7 +81,9 @@ int run(int argc, const char* const* argv) {
                  "(global, local), plus the VIO-only row: average over runs of the RMSE of the\n"
                  "target pose in the IMU frame, the target pose in the world and the IMU pose\n"
                  "(m / deg), over the camera frames after the target initialisation, and NEES.\n"
-                 "Options not swept come from the target config's `target:` section.\n"
+                 "Options not swept come from the target config's `target:` section. Per run (up to\n"
+                 "12 runs in all) also how well the target was tracked: frames with a target\n"
+                 "estimate, with target features, with a target update, the longest gap.\n"
                  "Exit status: 0, 2 if a run diverged, 1 on bad input.");
   args.add_option("sim-config", "FILE", "simulator scenario (config/sim_paper.yaml: the paper's semicircle)",
                   "config/sim_paper_rc_car.yaml");
@@ -158,6 +163,7 @@ int run(int argc, const char* const* argv) {
   o.first_seed = mca.first_seed;
   o.threads = mca.threads;
   o.fixed_perturb_seed = mca.perturb_seed;
+  o.pixels = mca.pixels;
   const std::size_t n_cells =
       (o.vio_only ? 1 : 0) + o.sigmas.size() * o.modes.size() * o.representations.size();
   if (n_cells == 0) throw ArgError("nothing to run (empty --sigmas/--modes/--representations and --no-vio-only)");
@@ -179,16 +185,28 @@ int run(int argc, const char* const* argv) {
   std::cout << "\n" << o.runs << " runs per cell, " << n_cells << " cells; wall time " << eval::hms(wall) << " on "
             << o.threads << " threads (" << eval::hms(wall * o.threads / static_cast<double>(n_cells * o.runs))
             << " per run and thread); machine: " << machine.nproc << " CPUs, " << machine.cpu_model << "\n";
-  std::cout << "target start: " << target::to_string(base_filter.init_mode) << "\n";
-  if (base_filter.init_mode == target::TargetInitMode::kFeatures && n_cells * static_cast<std::size_t>(o.runs) > 12) {
-    std::cout << "  (each run's target frame transform: summary.json, per_run target_frame)\n";
-  } else if (base_filter.init_mode == target::TargetInitMode::kFeatures) {
+  std::cout << "target start: " << target::to_string(base_filter.init_mode) << "; frames "
+            << (o.pixels ? "from pixels (" + args.get("pixels") + ", true target box)" : std::string("simulated features"))
+            << "\n";
+  if (n_cells * static_cast<std::size_t>(o.runs) > 12) {
+    std::cout << "  (each run's target tracking and target frame transform: summary.json, per_run)\n";
+  } else {
     for (const auto& c : cells) {
       if (c.vio_only) continue;
       for (const auto& r : c.runs) {
-        std::cout << "  " << target::to_string(c.filter.mode) << " " << target::to_string(c.filter.representation)
-                  << " σ_t " << c.filter.sigma_t << " seed " << r.sim_seed << ": filter's target frame in the true one "
-                  << r.target_frame.describe() << "\n";
+        const double n = static_cast<double>(std::max<int64_t>(1, r.imu.count));
+        std::printf("  %s %s σ_t %g seed %llu: target estimate on %lld of %lld frames (%.1f %%, started after %.2f s), "
+                    "target features on %.1f %%, target updates on %.1f %%, longest gap without target features "
+                    "%lld frames, max target-in-IMU position error %.3f m\n",
+                    target::to_string(c.filter.mode), target::to_string(c.filter.representation), c.filter.sigma_t,
+                    static_cast<unsigned long long>(r.sim_seed), static_cast<long long>(r.target_in_imu.count),
+                    static_cast<long long>(r.imu.count), 100.0 * static_cast<double>(r.target_in_imu.count) / n,
+                    r.target_init_s, 100.0 * static_cast<double>(r.frames_with_target_obs) / n,
+                    100.0 * static_cast<double>(r.frames_with_target_update) / n,
+                    static_cast<long long>(r.longest_gap_frames), r.target_max_error_m);
+        if (base_filter.init_mode == target::TargetInitMode::kFeatures) {
+          std::cout << "    filter's target frame in the true one " << r.target_frame.describe() << "\n";
+        }
       }
     }
   }
