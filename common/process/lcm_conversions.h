@@ -9,6 +9,7 @@
 #include "common/types/nav_state.h"
 #include "common/types/object_pose.h"
 #include "common/types/sensor_data.h"
+#include "common/types/target_box.h"
 #include "common/types/target_state.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
@@ -17,6 +18,7 @@
 #include "vimot/nav_state_t.hpp"
 #include "vimot/object_pose_t.hpp"
 #include "vimot/scale_estimate_t.hpp"
+#include "vimot/target_box_t.hpp"
 #include "vimot/target_prediction_t.hpp"
 #include "vimot/target_state_t.hpp"
 
@@ -36,6 +38,9 @@ NavState from_lcm(const nav_state_t& msg);
 
 target_state_t to_lcm(const TargetStateEstimate& state);
 TargetStateEstimate from_lcm(const target_state_t& msg);
+
+/// The covariance and velocity are not read (offline tools need the boxes).
+CameraTargetBox from_lcm(const target_box_t& msg);
 
 target_prediction_t to_lcm(const TargetPosePrediction& prediction);
 TargetPosePrediction from_lcm(const target_prediction_t& msg);

@@ -42,18 +42,25 @@ void load_with_its_reader(const std::string& name, const std::string& path) {
     CHECK(FeatureTrackerNodeOptions::from_config(cfg).cameras.size() == (mono ? 1u : 2u));
   } else if (name == "imu_mip.yaml") {
     CHECK(mip::imu_mip_config_from(cfg).driver.rate_hz > 0.0);
-  } else if (name == "mask_filter.yaml") {
+  } else if (name.rfind("mask_filter", 0) == 0) {
     const MaskFilterNodeOptions o = MaskFilterNodeOptions::from_config(cfg);
-    CHECK(o.resolution.size() == 2);
+    CHECK(o.resolution.size() == (name == "mask_filter_mono.yaml" ? 1u : 2u));
     CHECK(o.filter.kalman.max_coast_s == 1.0);
   } else if (name == "object_tracker.yaml") {
     CHECK(object_tracker_options_from_config(cfg).window_size == 20);
   } else if (name == "scale_estimator.yaml") {
     CHECK(scale_node_options_from_config(cfg).max_pending == 60);
-  } else if (name == "segmenter.yaml") {
+  } else if (name.rfind("segmenter", 0) == 0) {
     const SegmenterNodeOptions o = SegmenterNodeOptions::from_config(cfg);
-    CHECK(o.backend == SegmenterNodeOptions::Backend::kOnnx);
-    CHECK(o.onnx.model_file == source_path("config/models/segmenter_unet.onnx"));
+    CHECK(o.cameras == (name == "segmenter_mono.yaml" ? 1 : 2));
+    if (name == "segmenter_truth.yaml") {
+      CHECK(o.backend == SegmenterNodeOptions::Backend::kTruth);
+      CHECK(o.truth.dropout_frames >= 5);  // the corruption the issue asks the chain to survive
+      CHECK(o.truth.false_blob_rate > 0.0);
+    } else {
+      CHECK(o.backend == SegmenterNodeOptions::Backend::kOnnx);
+      CHECK(o.onnx.model_file == source_path("config/models/segmenter_unet.onnx"));
+    }
   } else if (name == "target_filter.yaml") {
     const TargetFilterNodeOptions o = node_options_from_config(cfg);
     CHECK(o.target_enabled);

@@ -47,6 +47,14 @@ TEST_CASE("shipped sheriff configs parse") {
                {"vins_euroc.yaml", "feature_tracker.yaml"});
   check_config("sim_pixels.pmd", {"logger", "vins", "target_filter", "feature_tracker", "sim"},
                {"target_filter.yaml"});
+  check_config("sim_segmented.pmd",
+               {"logger", "vins", "target_filter", "segmenter", "mask_filter", "feature_tracker", "sim"},
+               {"target_filter.yaml"});
+  check_config("sim_mono_segmented.pmd",
+               {"logger", "vins", "object_tracker", "scale_estimator", "segmenter", "mask_filter", "feature_tracker",
+                "sim"},
+               {"vins_mono.yaml", "object_tracker.yaml", "scale_estimator.yaml", "segmenter_mono.yaml",
+                "mask_filter_mono.yaml", "feature_tracker_segmented_mono.yaml"});
 }
 
 TEST_CASE("the two-host layout puts each command on its machine") {
