@@ -2,8 +2,12 @@
 # The README's main job: the simulated scenario through the LCM stack.
 #   scripts/demo.sh        stereo target tracking (Schmidt-EKF paper)
 #   scripts/demo.sh mono   monocular metric scale (scale paper)
-#   scripts/demo.sh pixels stereo target tracking from rendered images: the
-#                          simulator renders, the feature tracker makes FEATURES
+#   scripts/demo.sh pixels stereo target tracking from rendered images with no
+#                          ground truth in the chain: the simulator renders, the
+#                          segmentation network finds the target, the mask
+#                          filter its box, the feature tracker makes FEATURES
+#   scripts/demo.sh pixels-truthbox  the same with the simulator's true target
+#                          box instead of the network and the mask filter
 # Installs what is missing, builds, starts the processes of a sheriff config
 # with vimot-sheriff and prints a summary: processes, messages per channel,
 # the accuracy of the LCM run against ground truth, the same scenario run
@@ -15,25 +19,35 @@
 #  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
 #    scale estimator, lcm-logger): VIO accuracy, scale error, the metric
 #    object pose error in the world and that of the object motion filter.
-#  - pixels: sheriff_configs/sim_pixels.pmd (simulator rendering images,
-#    feature tracker with the true target box, vins, target filter,
-#    lcm-logger): VIO accuracy of the LCM run against the same seed's
-#    offline run from pixels (vimot-vio-eval --pixels) and next to the
-#    feature-level run of that seed.
+#  - pixels: sheriff_configs/sim_segmented.pmd (simulator rendering images,
+#    segmenter with the shipped network, mask filter, feature tracker on the
+#    mask filter's box, vins, target filter, lcm-logger;
+#    docs/segmented_pipeline.md): VIO accuracy of the LCM run against the
+#    same seed's offline run of the same chain (vimot-vio-eval --pixels
+#    --segmenter --mask-filter), the target box against the true one, and the
+#    target accuracy next to the feature-level run of that seed.
+#  - pixels-truthbox: sheriff_configs/sim_pixels.pmd (feature tracker with
+#    the true target box): VIO accuracy against the offline run from pixels
+#    (vimot-vio-eval --pixels) and next to the feature-level run.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
 #                     sim_mono.yaml)
-#   VIMOT_SPEED       simulator real-time factor (default 2; mono and pixels: 1,
-#                     the object tracker's bundle adjustment takes ≈ 20 ms per
-#                     frame; on 2 cores at 4x UDP already loses IMU messages,
-#                     which the heartbeats count, and the demo then fails)
+#   VIMOT_SPEED       simulator real-time factor (default 2; mono and
+#                     pixels-truthbox: 1, the object tracker's bundle
+#                     adjustment takes ≈ 20 ms per frame; pixels: 0.25, the
+#                     network takes ≈ 70 ms per image; on 2 cores at 4x UDP
+#                     already loses IMU messages, which the heartbeats count,
+#                     and the demo then fails)
 #   VIMOT_SEED        noise seed (default 1)
 #   VIMOT_DURATION    pixels: seconds to simulate (default 30; rendering and
 #                     tracking cost ≈ 25 ms per stereo frame, so the default
 #                     speed there is 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml; mono:
 #                     vins_mono.yaml)
+#   VIMOT_SEGMENTER_CONFIG  pixels: segmenter file in config/ (default
+#                     segmenter.yaml, the network; segmenter_truth.yaml: the
+#                     true masks with dropouts and false blobs)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
 #   LCM_DEFAULT_URL   LCM network (default
 #                     udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304: never
@@ -49,8 +63,9 @@ case "${1:-}" in
   -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
   mono) pipeline=mono ;;
   pixels) pipeline=pixels ;;
+  pixels-truthbox) pipeline=pixels-truthbox ;;
   "") ;;
-  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels' or --help)" >&2; exit 1 ;;
+  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels', 'pixels-truthbox' or --help)" >&2; exit 1 ;;
 esac
 
 "$here/scripts/build.sh"
@@ -63,6 +78,14 @@ if [ $pipeline = mono ]; then
   export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
   export VIMOT_SPEED="${VIMOT_SPEED:-1}"
 elif [ $pipeline = pixels ]; then
+  pmd="$here/sheriff_configs/sim_segmented.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
+  export VIMOT_TRACKER_CONFIG="${VIMOT_TRACKER_CONFIG:-feature_tracker_segmented.yaml}"
+  export VIMOT_SEGMENTER_CONFIG="${VIMOT_SEGMENTER_CONFIG:-segmenter.yaml}"
+  export VIMOT_MASK_FILTER_CONFIG="${VIMOT_MASK_FILTER_CONFIG:-mask_filter.yaml}"
+  export VIMOT_DURATION="${VIMOT_DURATION:-30}"
+  export VIMOT_SPEED="${VIMOT_SPEED:-0.25}"
+elif [ $pipeline = pixels-truthbox ]; then
   pmd="$here/sheriff_configs/sim_pixels.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
   export VIMOT_TRACKER_CONFIG="${VIMOT_TRACKER_CONFIG:-feature_tracker_sim.yaml}"
@@ -101,8 +124,11 @@ echo "== VIO accuracy of the LCM run (VINS_STATE vs GROUND_TRUTH):"
 perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" | head -n 1)
 # The same seed offline, in-process: the figures the LCM run must equal.
 offline_args=()
-if [ $pipeline = pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ]; then
   offline_args=(--duration "$VIMOT_DURATION" --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG")
+fi
+if [ $pipeline = pixels ]; then
+  offline_args+=(--segmenter "$VIMOT_CONFIG/$VIMOT_SEGMENTER_CONFIG" --mask-filter "$VIMOT_CONFIG/$VIMOT_MASK_FILTER_CONFIG")
 fi
 "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
   --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
@@ -124,6 +150,32 @@ finish() {
 }
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
 if [ $pipeline = pixels ]; then
+  echo "== target box of the LCM run (TARGET_BOX vs TARGET_BOX_TRUTH) and target accuracy (TARGET_STATE vs GROUND_TRUTH):"
+  "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE \
+    --own-target-frame --box-channel TARGET_BOX > "$out/lcm_target.txt" 2>&1 || true
+  grep -E '^(box|target (kept|in IMU|states))' "$out/lcm_target.txt" | sed 's/^/   /'
+  echo "== the same seed at feature level (the simulator's own tracks and true target features), offline:"
+  target_cfg="$VIMOT_CONFIG/target_filter.yaml"
+  target_key() { sed -n "s/^  $1: *\([a-z0-9.]*\).*/\1/p" "$target_cfg" | head -n 1; }
+  "$VIMOT_BIN/vimot-target-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+    --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-config "$target_cfg" \
+    --modes "$(target_key mode)" --representations "$(target_key representation)" \
+    --sigmas "$(target_key sigma_t)" --no-vio-only --runs 1 --first-seed "$VIMOT_SEED" --duration "$VIMOT_DURATION" \
+    --perturb-seed "${perturb_seed:-0}" --out "$out/offline_target_features" --quiet > "$out/offline_target_features.txt" 2>&1 || true
+  "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE --own-target-frame \
+    --compare-target "$out/offline_target_features/summary.json" > "$out/lcm_vs_features_target.txt" 2>&1 || true
+  grep -E '^  (target in IMU|target samples)' "$out/lcm_vs_features_target.txt" \
+    | sed 's/^  /   LCM from pixels vs feature level: /'
+  echo "   (feature-level target run: $out/offline_target_features.txt)"
+  echo "   VIO at feature level:"
+  "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
+    --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
+    --duration "$VIMOT_DURATION" --perturb-seed "${perturb_seed:-0}" --quiet > "$out/offline_features.txt" 2>&1 || true
+  grep -E '^(seed|mean|pred)' "$out/offline_features.txt" | sed 's/^/   /'
+  echo "== log (images and masks left out): $VIMOT_LOG"
+  finish
+fi
+if [ $pipeline = pixels-truthbox ]; then
   echo "== the same seed at feature level (the simulator's own tracks, no pixels), offline:"
   "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
     --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
