@@ -97,7 +97,7 @@ ChainRun run_chain(const eval::EvaluationSetup& setup, const target::TargetFilte
       },
       &front);
   r.target_in_imu = errors.summary();
-  r.corruption = *front.box_chain()->corruption_counts();
+  if (const auto* c = front.box_chain()->corruption_counts()) r.corruption = *c;
   r.twin = twin.counts();
   return r;
 }
