@@ -7,7 +7,10 @@
 // sheriff_configs/sim_segmented.pmd, in-process and without LCM. The
 // renderer (the simulator's camera) is timed apart, not in the stack.
 // Thread CPU time (other jobs on a shared machine do not inflate it), one
-// OpenCV thread.
+// OpenCV thread. Also prints what the run computed: the filtered box against
+// the true one, and the target in the IMU frame against the truth
+// (vimot-target-eval's conventions, the filter's own target frame) next to
+// the feature-level run of the same seed (the simulator's own tracks).
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -23,6 +26,8 @@
 #include "common/eval/machine.h"
 #include "common/eval/sim_runner.h"
 #include "common/eval/target_eval.h"
+#include "common/eval/target_frame.h"
+#include "common/segmentation/blob.h"
 #include "common/frontend/feature_tracker.h"
 #include "common/process/arg_parser.h"
 #include "common/segmentation/box_chain.h"
@@ -93,9 +98,19 @@ int run(int argc, const char* const* argv) {
   Stage render{"renderer (the simulator, not in the stack)", {}};
   Stage segment{"segmenter, 2 images", {}}, mask{"mask filter, 2 masks", {}}, track{"feature tracker", {}};
   Stage update{"VIO + target filter: camera update", {}}, propagate{"VIO + target filter: IMU propagation", {}};
+  GroundTruth truth;
+  bool target_seen = false, frame_known = false;
+  eval::TargetFrameTransform X;
+  eval::TrajectoryErrors target_errors;
+  double iou_sum = 0.0;
+  int64_t boxes_valid = 0, visible = 0;
   double frame_end = thread_cpu_ms();
   eval::play_simulator(
-      sim, est, [&](const GroundTruth& gt) { filter.set_ground_truth(gt); },
+      sim, est,
+      [&](const GroundTruth& gt) {
+        truth = gt;
+        filter.set_ground_truth(gt);
+      },
       [&](const CameraFrame& simulated) {
         // Since the last frame: the IMU samples into the estimator (and the
         // simulator making them, a small part).
@@ -112,8 +127,10 @@ int run(int argc, const char* const* argv) {
         for (const sim::RenderedView& v : views) masks.push_back(segmenter.segment(v.image));
         lap(segment);
         std::optional<frontend::Box> boxes[2];
+        segmentation::BoxEstimate estimates[2];
         for (std::size_t c = 0; c < 2; ++c) {
-          if (const auto b = segmentation::tracker_box(filters[c].process(simulated.utime, masks[c]))) {
+          estimates[c] = filters[c].process(simulated.utime, masks[c]);
+          if (const auto b = segmentation::tracker_box(estimates[c])) {
             boxes[c] = frontend::Box{(*b)(0), (*b)(1), (*b)(2), (*b)(3)};
           }
         }
@@ -122,7 +139,26 @@ int run(int argc, const char* const* argv) {
         lap(track);
         const estimator::FrameStatus st = est.feed_camera(tracked);
         lap(update);
-        frame_end = t;
+        // Accuracy (not timed).
+        for (std::size_t c = 0; c < 2; ++c) {
+          if (!views[c].visible) continue;
+          ++visible;
+          if (!estimates[c].filtered_valid) continue;
+          ++boxes_valid;
+          iou_sum += segmentation::box_iou(estimates[c].filtered_box, views[c].box);
+        }
+        for (const FeatureObservation& o : tracked.observations) target_seen = target_seen || o.is_target;
+        if (filter.initialized() && truth.utime == simulated.utime && truth.has_target && target_seen &&
+            st == estimator::FrameStatus::kProcessed) {
+          const target::TargetValue x = filter.value();
+          if (!frame_known) X = eval::target_frame_transform(truth, x.q_RtoT, x.p_TinR);
+          frame_known = true;
+          const eval::TargetInImu ti = eval::true_target_in_imu(eval::in_target_frame(truth, X));
+          const target::Matrix12d P = filter.covariance();
+          target_errors.add(eval::compute_error(simulated.utime, ti.q_ItoT, ti.p_TinI, x.q_RtoT, x.p_TinR,
+                                                P.block<3, 3>(0, 0), P.block<3, 3>(3, 3)));
+        }
+        frame_end = thread_cpu_ms();
         return st != estimator::FrameStatus::kDiverged;
       });
 
@@ -146,6 +182,20 @@ int run(int argc, const char* const* argv) {
   std::printf("%-42s %9.2f %9.2f %9.2f %6.1f%%\n", whole.name, whole.mean(), whole.quantile(0.5), whole.quantile(0.95),
               100.0);
   std::printf("%-42s %9.2f %9.2f %9.2f\n", render.name, render.mean(), render.quantile(0.5), render.quantile(0.95));
+
+  const eval::ErrorSummary e = target_errors.summary();
+  std::printf("box: valid filtered box in %lld of %lld camera images with the target, mean IoU with the true box %.3f\n",
+              static_cast<long long>(boxes_valid), static_cast<long long>(visible),
+              boxes_valid > 0 ? iou_sum / static_cast<double>(boxes_valid) : 0.0);
+  std::printf("target in IMU, this run (pixels, segmenter, mask filter): position RMSE %.4f m, orientation RMSE "
+              "%.3f deg, %lld frames\n",
+              e.rmse_position_m, e.rmse_orientation_deg, static_cast<long long>(e.count));
+  const eval::TargetRunResult ref = eval::run_target_on_sim(setup.sim, setup.vio, fo, perturb_seed, nullptr, false);
+  std::printf("target in IMU, feature level (same seed and start): position RMSE %.4f m, orientation RMSE %.3f deg; "
+              "ratio %.2f / %.2f\n",
+              ref.target_in_imu.rmse_position_m, ref.target_in_imu.rmse_orientation_deg,
+              e.rmse_position_m / ref.target_in_imu.rmse_position_m,
+              e.rmse_orientation_deg / ref.target_in_imu.rmse_orientation_deg);
   return 0;
 }
 
