@@ -2,8 +2,12 @@
 # The README's main job: the simulated scenario through the LCM stack.
 #   scripts/demo.sh        stereo target tracking (Schmidt-EKF paper)
 #   scripts/demo.sh mono   monocular metric scale (scale paper)
-#   scripts/demo.sh pixels stereo target tracking from rendered images: the
-#                          simulator renders, the feature tracker makes FEATURES
+#   scripts/demo.sh pixels stereo target tracking from rendered images with no
+#                          ground truth in the chain: the simulator renders, the
+#                          segmentation network finds the target, the mask
+#                          filter its box, the feature tracker makes FEATURES
+#   scripts/demo.sh pixels-truthbox  the same with the simulator's true target
+#                          box instead of the network and the mask filter
 #   scripts/demo.sh mono-pixels  monocular metric scale from rendered images
 # Installs what is missing, builds, starts the processes of a sheriff config
 # with vimot-sheriff and prints a summary: processes, messages per channel,
@@ -16,11 +20,17 @@
 #  - mono: sheriff_configs/sim_mono.pmd (simulator, vins, object tracker,
 #    scale estimator, lcm-logger): VIO accuracy, scale error, the metric
 #    object pose error in the world and that of the object motion filter.
-#  - pixels: sheriff_configs/sim_pixels.pmd (simulator rendering images,
-#    feature tracker with the true target box, vins, target filter,
-#    lcm-logger): VIO and target accuracy of the LCM run against the same
-#    seed's offline run from pixels (vimot-vio-eval / vimot-target-eval
-#    --pixels) and next to the feature-level runs of that seed.
+#  - pixels: sheriff_configs/sim_segmented.pmd (simulator rendering images,
+#    segmenter with the shipped network, mask filter, feature tracker on the
+#    mask filter's box, vins, target filter, lcm-logger;
+#    docs/segmented_pipeline.md): VIO and target accuracy of the LCM run
+#    against the same seed's offline run of the same chain (vimot-vio-eval /
+#    vimot-target-eval --pixels --segmenter --mask-filter), the target box
+#    against the true one, and the accuracy next to the feature-level runs
+#    of that seed.
+#  - pixels-truthbox: sheriff_configs/sim_pixels.pmd (feature tracker with
+#    the true target box): the same comparisons with the offline run from
+#    pixels (--pixels only).
 #  - mono-pixels: sheriff_configs/sim_mono_pixels.pmd (simulator rendering
 #    cam0, feature tracker with the true target box, vins, object tracker,
 #    scale estimator, lcm-logger): VIO accuracy and the scale figures of the
@@ -31,14 +41,15 @@
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
 #                     sim_mono.yaml)
-#   VIMOT_SPEED       simulator real-time factor (default 2; mono and pixels: 1,
-#                     mono-pixels: 0.5, but the object tracker's bundle
-#                     adjustment on the long target KLT tracks takes ≈ 200 ms
-#                     per frame, so it falls behind and the demo fails (exit 4)
-#                     unless the speed is lower (docs/scale_estimator.md),
-#                     the object tracker's bundle adjustment takes ≈ 20 ms per
-#                     frame; on 2 cores at 4x UDP already loses IMU messages,
-#                     which the heartbeats count, and the demo then fails)
+#   VIMOT_SPEED       simulator real-time factor (default 2; mono and
+#                     pixels-truthbox: 1, the object tracker's bundle
+#                     adjustment takes ≈ 20 ms per frame; pixels: 0.25, the
+#                     network takes ≈ 70 ms per image; mono-pixels: 0.5, but
+#                     the object tracker takes ≈ 200 ms per frame on the long
+#                     target KLT tracks, so it falls behind and the demo fails
+#                     (exit 4) unless the speed is lower, docs/scale_estimator.md;
+#                     on 2 cores at 4x UDP already loses IMU messages, which
+#                     the heartbeats count, and the demo then fails)
 #   VIMOT_SEED        noise seed (default 1)
 #   VIMOT_DURATION    pixels: seconds to simulate (default 30; mono-pixels 60,
 #                     the scale estimator's 40 s window needs most of it; rendering and
@@ -46,6 +57,9 @@
 #                     speed there is 1)
 #   VIMOT_VINS_CONFIG estimator file in config/ (default vins.yaml; mono:
 #                     vins_mono.yaml)
+#   VIMOT_SEGMENTER_CONFIG  pixels: segmenter file in config/ (default
+#                     segmenter.yaml, the network; segmenter_truth.yaml: the
+#                     true masks with dropouts and false blobs)
 #   VIMOT_OUT         output folder (default out/demo-<date>)
 #   LCM_DEFAULT_URL   LCM network (default
 #                     udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304: never
@@ -61,9 +75,10 @@ case "${1:-}" in
   -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
   mono) pipeline=mono ;;
   pixels) pipeline=pixels ;;
+  pixels-truthbox) pipeline=pixels-truthbox ;;
   mono-pixels) pipeline=mono_pixels ;;
   "") ;;
-  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels', 'mono-pixels' or --help)" >&2; exit 1 ;;
+  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels', 'pixels-truthbox', 'mono-pixels' or --help)" >&2; exit 1 ;;
 esac
 
 "$here/scripts/build.sh"
@@ -76,6 +91,14 @@ if [ $pipeline = mono ]; then
   export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
   export VIMOT_SPEED="${VIMOT_SPEED:-1}"
 elif [ $pipeline = pixels ]; then
+  pmd="$here/sheriff_configs/sim_segmented.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
+  export VIMOT_TRACKER_CONFIG="${VIMOT_TRACKER_CONFIG:-feature_tracker_segmented.yaml}"
+  export VIMOT_SEGMENTER_CONFIG="${VIMOT_SEGMENTER_CONFIG:-segmenter.yaml}"
+  export VIMOT_MASK_FILTER_CONFIG="${VIMOT_MASK_FILTER_CONFIG:-mask_filter.yaml}"
+  export VIMOT_DURATION="${VIMOT_DURATION:-30}"
+  export VIMOT_SPEED="${VIMOT_SPEED:-0.25}"
+elif [ $pipeline = pixels-truthbox ]; then
   pmd="$here/sheriff_configs/sim_pixels.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
   export VIMOT_TRACKER_CONFIG="${VIMOT_TRACKER_CONFIG:-feature_tracker_sim.yaml}"
@@ -122,8 +145,11 @@ echo "== VIO accuracy of the LCM run (VINS_STATE vs GROUND_TRUTH):"
 perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" | head -n 1)
 # The same seed offline, in-process: the figures the LCM run must equal.
 offline_args=()
-if [ $pipeline = pixels ] || [ $pipeline = mono_pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ] || [ $pipeline = mono_pixels ]; then
   offline_args=(--duration "$VIMOT_DURATION" --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG")
+fi
+if [ $pipeline = pixels ]; then
+  offline_args+=(--segmenter "$VIMOT_CONFIG/$VIMOT_SEGMENTER_CONFIG" --mask-filter "$VIMOT_CONFIG/$VIMOT_MASK_FILTER_CONFIG")
 fi
 "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
   --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
@@ -144,12 +170,18 @@ finish() {
   exit 0
 }
 echo "   (offline run of the same scenario and seed: $out/offline.txt)"
-if [ $pipeline = pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ]; then
   echo "== the same seed at feature level (the simulator's own tracks, no pixels), offline:"
   "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
     --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --runs 1 --first-seed "$VIMOT_SEED" \
     --duration "$VIMOT_DURATION" --perturb-seed "${perturb_seed:-0}" --quiet > "$out/offline_features.txt" 2>&1 || true
   grep -E '^(seed|mean|pred)' "$out/offline_features.txt" | sed 's/^/   /'
+fi
+if [ $pipeline = pixels ]; then
+  echo "== target box of the LCM run (TARGET_BOX vs TARGET_BOX_TRUTH):"
+  "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --state-channel NAV_STATE --target-channel TARGET_STATE \
+    --own-target-frame --box-channel TARGET_BOX > "$out/lcm_box.txt" 2>&1 || true
+  grep -E '^(box|target kept)' "$out/lcm_box.txt" | sed 's/^/   /'
 fi
 if [ $pipeline = mono_pixels ]; then
   echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run from pixels:"
@@ -214,13 +246,13 @@ if [ "$target_status" -ne 0 ] && [ "$lcm_vs_offline" -eq 0 ]; then
   cat "$out/lcm_vs_offline_target.txt" >> "$out/lcm_vs_offline.txt"
 fi
 echo "   (offline target run: $out/offline_target.txt)"
-if [ $pipeline = pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ]; then
   echo "== the same seed's target at feature level (the simulator's own tracks, no pixels), offline:"
   target_eval offline_target_features --duration "$VIMOT_DURATION"
   grep -E '^(\| (σ_t|[0-9])|Table|Average|  .*target estimate on)' "$out/offline_target_features.txt" \
     | sed 's/^ */   /'
   echo "   (from pixels: $out/offline_target.txt)"
-  echo "== log (images left out): $VIMOT_LOG"
+  echo "== log (images and masks left out): $VIMOT_LOG"
   finish
 fi
 echo "== log: $VIMOT_LOG"

@@ -1,6 +1,7 @@
 #include "common/eval/log_eval.h"
 
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "common/eval/json.h"
@@ -35,9 +36,28 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   std::map<int64_t, GroundTruth> target_truths;  // for the metric poses
   // A channel keeps its first handler: the state channel wins over the
   // others, the truth channel is the last resort (as the channels are meant).
-  log.on_nav_state(options.state_channel, [&](const NavState& x) { matcher.add_state(x); }, &r.malformed_states);
-  log.on_target_state(options.target_channel, [&](const TargetStateEstimate& x) { matcher.add_target(x); },
-                      &r.malformed_targets);
+  std::vector<int64_t> state_utimes;  // updated states, for the target kept
+  std::set<int64_t> target_utimes;
+  log.on_nav_state(
+      options.state_channel,
+      [&](const NavState& x) {
+        matcher.add_state(x);
+        if (x.updated) state_utimes.push_back(x.utime);
+      },
+      &r.malformed_states);
+  log.on_target_state(
+      options.target_channel,
+      [&](const TargetStateEstimate& x) {
+        matcher.add_target(x);
+        target_utimes.insert(x.utime);
+      },
+      &r.malformed_targets);
+  std::vector<CameraTargetBox> boxes, box_truths;
+  if (!options.box_channel.empty()) {
+    log.on_target_box(options.box_channel, [&](const CameraTargetBox& b) { boxes.push_back(b); }, &r.malformed_boxes);
+    log.on_target_box(options.box_truth_channel, [&](const CameraTargetBox& b) { box_truths.push_back(b); },
+                      &r.malformed_boxes);
+  }
   if (scale_on) {
     log.on_scale_estimate(options.scale_channel, [&](const scale::ScaleResult& x) { estimates.push_back(x); },
                           &r.malformed_scale);
@@ -66,7 +86,15 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
     for (const ErrorSample& s : r.target_samples.target_in_world) in_world.add(s);
     r.target_in_imu = in_imu.summary();
     r.target_in_world = in_world.summary();
+    if (!target_utimes.empty()) {
+      for (const int64_t t : state_utimes) {
+        if (t < *target_utimes.begin()) continue;
+        ++r.frames_since_target_start;
+        r.frames_with_target += target_utimes.count(t) > 0 ? 1 : 0;
+      }
+    }
   }
+  if (!options.box_channel.empty()) r.boxes = evaluate_boxes(boxes, box_truths);
   if (scale_on) {
     ScaleFigureBuilder figures;
     for (const TrackTruth& t : options.tracks) figures.start_track(t.start_utime, t.truth);

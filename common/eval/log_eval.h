@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/eval/box_eval.h"
 #include "common/eval/metrics.h"
 #include "common/eval/scale_eval.h"
 #include "common/eval/truth_matcher.h"
@@ -32,6 +33,10 @@ struct LogEvalOptions {
   std::string metric_channel;
   std::string object_state_channel;  // target_state_t of the object motion filter; empty: none
   std::vector<TrackTruth> tracks;
+  // Segmented pipeline: target_box_t of the mask filter against the
+  // rendered simulator's true boxes (box_eval.h); empty: none.
+  std::string box_channel;
+  std::string box_truth_channel{"TARGET_BOX_TRUTH"};
 };
 
 struct LogEvalResult {
@@ -48,6 +53,13 @@ struct LogEvalResult {
   TargetMatch target_samples;
   TargetMatchCounts target_counts;
   int64_t malformed_targets{0};
+  /// Target kept (target_channel given): updated states on state_channel
+  /// from the first target state on, and those with a target state at
+  /// their utime.
+  int64_t frames_since_target_start{0};
+  int64_t frames_with_target{0};
+  std::vector<BoxCameraFigures> boxes;  // box_channel given: per camera
+  int64_t malformed_boxes{0};
   ScaleFigures scale;
   int64_t malformed_scale{0};   // on scale_channel, metric_channel or object_state_channel
   int64_t metric_without_truth{0};

@@ -5,18 +5,34 @@
 namespace vimot {
 namespace eval {
 
-PixelFrontEnd::PixelFrontEnd(const sim::Simulator& sim, const frontend::FeatureTrackerOptions& options)
-    : renderer_(sim), tracker_(options, sim.cameras()) {}
+PixelFrontEnd::PixelFrontEnd(const sim::Simulator& sim, const frontend::FeatureTrackerOptions& options,
+                             const std::optional<segmentation::BoxChainOptions>& boxes)
+    : renderer_(sim), tracker_(options, sim.cameras()) {
+  if (boxes) chain_.emplace(*boxes, static_cast<int>(sim.cameras().size()));
+}
 
 CameraFrame PixelFrontEnd::frame(int64_t utime) {
   views_ = renderer_.render(utime);
   const std::vector<sim::RenderedView>& views = views_;
-  // A box only where the target is visible: the feature tracker node takes
-  // TARGET_BOX_TRUTH's filtered box only when filtered_valid (= visible).
-  auto box_of = [&views](std::size_t cam) -> std::optional<frontend::Box> {
-    if (cam >= views.size() || !views[cam].visible) return std::nullopt;
-    const auto& b = views[cam].box;
-    return frontend::Box{b(0), b(1), b(2), b(3)};
+  boxes_.clear();
+  if (chain_) {
+    for (std::size_t cam = 0; cam < views.size(); ++cam) {
+      boxes_.push_back(chain_->process(static_cast<int>(cam), utime, views[cam].image, views[cam].mask));
+    }
+  }
+  // Truth: a box only where the target is visible (the feature tracker node
+  // takes TARGET_BOX_TRUTH's filtered box only when filtered_valid =
+  // visible). Box chain: what the node takes from TARGET_BOX.
+  auto box_of = [&](std::size_t cam) -> std::optional<frontend::Box> {
+    if (cam >= views.size()) return std::nullopt;
+    std::optional<Eigen::Vector4d> b;
+    if (chain_) {
+      b = segmentation::tracker_box(boxes_[cam]);
+    } else if (views[cam].visible) {
+      b = views[cam].box;
+    }
+    if (!b) return std::nullopt;
+    return frontend::Box{(*b)(0), (*b)(1), (*b)(2), (*b)(3)};
   };
   const cv::Mat right = views.size() > 1 ? views[1].image : cv::Mat();
   return tracker_.track(utime, views[0].image, right, box_of(0), box_of(1));

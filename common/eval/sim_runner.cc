@@ -41,7 +41,7 @@ SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::V
   sim::Simulator sim(cfg);
   VioEstimator est(options);
   std::optional<PixelFrontEnd> pixels;
-  if (ro.pixels) pixels.emplace(sim, *ro.pixels);
+  if (ro.pixels) pixels.emplace(sim, *ro.pixels, ro.box_chain);
 
   SimRunResult r;
   r.sim_seed = cfg.seed;
@@ -229,6 +229,7 @@ std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const esti
         SimRunOptions ro;
         ro.keep_samples = o.keep_samples;
         ro.pixels = o.pixels;
+        ro.box_chain = o.box_chain;
         ro.progress = fr;
         results[static_cast<std::size_t>(i)] = run_vio_on_sim(cfg, options, perturb_seed_of(o, seed), ro);
       },

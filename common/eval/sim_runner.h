@@ -57,6 +57,9 @@ struct SimRunOptions {
   /// Set: frames from pixels — rendered images through the feature tracker
   /// with these options (PixelFrontEnd) instead of the simulated tracks.
   std::optional<frontend::FeatureTrackerOptions> pixels;
+  /// With pixels: the target box from the segmenter and mask filter
+  /// (PixelFrontEnd's box chain) instead of the truth.
+  std::optional<segmentation::BoxChainOptions> box_chain;
   /// Fraction of the run's camera frames done, after every frame (called
   /// on the thread running the simulation).
   std::function<void(double)> progress;
@@ -109,6 +112,7 @@ struct MonteCarloOptions {
   bool perturb{true};              // false: every run starts exactly at the truth
   bool keep_samples{true};
   std::optional<frontend::FeatureTrackerOptions> pixels;  // as SimRunOptions::pixels
+  std::optional<segmentation::BoxChainOptions> box_chain;  // as SimRunOptions::box_chain
   /// Nonzero: every run uses this perturbation seed (to reproduce one run
   /// of the `vins` process, whose config names its seed).
   uint64_t fixed_perturb_seed{0};

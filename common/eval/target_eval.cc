@@ -40,13 +40,14 @@ target::TargetFilterOptions target_filter_options(const Config& config) {
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                                   const std::optional<target::TargetFilterOptions>& filter_options,
                                   uint64_t perturb_seed, const std::function<void(double)>& progress,
-                                  bool keep_samples, const std::optional<frontend::FeatureTrackerOptions>& pixels) {
+                                  bool keep_samples, const std::optional<frontend::FeatureTrackerOptions>& pixels,
+                                  const std::optional<segmentation::BoxChainOptions>& box_chain) {
   const auto wall_start = std::chrono::steady_clock::now();
   sim::SimConfig cfg = sim_config;
   cfg.ground_truth_events = true;
   sim::Simulator sim(cfg);
   std::optional<PixelFrontEnd> pixel_frontend;
-  if (pixels) pixel_frontend.emplace(sim, *pixels);
+  if (pixels) pixel_frontend.emplace(sim, *pixels, box_chain);
   VioEstimator est(options);
   TargetRunResult r;
   r.sim_seed = cfg.seed;
@@ -214,7 +215,7 @@ std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estim
         if (!c.vio_only) f = c.filter;
         c.runs[static_cast<std::size_t>(i)] =
             run_target_on_sim(cfg, options, f, o.fixed_perturb_seed.value_or(estimator::perturb_seed_for_run(seed)), fr,
-                              o.keep_samples, o.pixels);
+                              o.keep_samples, o.pixels, o.box_chain);
       },
       progress);
   return cells;
@@ -356,7 +357,8 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
   j.begin_object();
   j.field("tool", "vimot-target-eval").field("sim_config", sim_config).field("vins_config", vins_config);
   j.field("target_config", target_config).field("runs", o.runs).field("first_seed", o.first_seed);
-  j.field("threads", o.threads).field("wall_s", wall_s).field("from_pixels", o.pixels.has_value());
+  j.field("threads", o.threads).field("wall_s", wall_s).field("from_pixels", o.pixels.has_value())
+      .field("box_from_segmenter", o.box_chain.has_value());
   j.key("cells").begin_array();
   for (const TargetCell& c : cells) {
     const TargetCellSummary s = summarize(c);

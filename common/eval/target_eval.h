@@ -28,7 +28,8 @@
 // RMSE and mean NEES per run (TrajectoryErrors); a cell of the sweep
 // averages its runs (diverged runs are left out and counted).
 // From pixels (`pixels` set): the frames are the features PixelFrontEnd
-// tracks in the rendered images (true box), as vimot-vio-eval --pixels; the
+// tracks in the rendered images (true box, or with a box chain the segmenter
+// and mask filter's box), as vimot-vio-eval --pixels; the
 // truth and the samples are the same.
 
 #include <cstdint>
@@ -41,6 +42,7 @@
 #include "common/eval/sim_runner.h"
 #include "common/eval/target_frame.h"
 #include "common/frontend/tracker_options.h"
+#include "common/segmentation/box_chain.h"
 #include "common/target/target_filter.h"
 
 namespace vimot {
@@ -90,11 +92,13 @@ struct TargetRunResult {
 /// One run on `sim_config` (its seed and duration); filter == nullopt: VIO
 /// only. `progress` gets the fraction of camera frames done. keep_samples:
 /// also return the per-frame target errors. pixels: frames from the rendered
-/// images through the feature tracker with these options.
+/// images through the feature tracker with these options; box_chain (with
+/// pixels): the target box from the segmenter and mask filter, not the truth.
 TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
                                   const std::optional<target::TargetFilterOptions>& filter, uint64_t perturb_seed,
                                   const std::function<void(double)>& progress = {}, bool keep_samples = false,
-                                  const std::optional<frontend::FeatureTrackerOptions>& pixels = std::nullopt);
+                                  const std::optional<frontend::FeatureTrackerOptions>& pixels = std::nullopt,
+                                  const std::optional<segmentation::BoxChainOptions>& box_chain = std::nullopt);
 
 /// One cell of the sweep: a filter configuration (or VIO only) × runs.
 struct TargetCell {
@@ -128,6 +132,7 @@ struct TargetSweepOptions {
   std::optional<uint64_t> fixed_perturb_seed;
   /// Frames from pixels (run_target_on_sim's `pixels`).
   std::optional<frontend::FeatureTrackerOptions> pixels;
+  std::optional<segmentation::BoxChainOptions> box_chain;  // as run_target_on_sim's
 };
 
 /// Every cell (VIO only first, then modes × representations × sigmas in

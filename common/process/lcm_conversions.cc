@@ -233,6 +233,21 @@ TargetStateEstimate from_lcm(const target_state_t& msg) {
   return s;
 }
 
+CameraTargetBox from_lcm(const target_box_t& msg) {
+  CameraTargetBox b;
+  b.utime = msg.utime;
+  if (msg.camera_id != 0 && msg.camera_id != 1) {
+    throw std::invalid_argument("target_box_t: camera_id " + std::to_string(msg.camera_id) + " is not 0 or 1");
+  }
+  b.camera_id = msg.camera_id;
+  b.raw_valid = msg.raw_valid;
+  b.filtered_valid = msg.filtered_valid;
+  if (b.raw_valid) b.raw_box = read<4>(msg.raw_box, "target_box_t.raw_box", msg.utime);
+  if (b.filtered_valid) b.filtered_box = read<4>(msg.filtered_box, "target_box_t.filtered_box", msg.utime);
+  b.frames_since_raw = msg.frames_since_raw;
+  return b;
+}
+
 target_prediction_t to_lcm(const TargetPosePrediction& p) {
   target_prediction_t msg{};
   msg.utime = p.utime;

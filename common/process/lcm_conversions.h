@@ -12,6 +12,7 @@
 #include "common/types/nav_state.h"
 #include "common/types/object_pose.h"
 #include "common/types/sensor_data.h"
+#include "common/types/target_box.h"
 #include "common/types/target_state.h"
 #include "vimot/features_t.hpp"
 #include "vimot/ground_truth_t.hpp"
@@ -40,6 +41,9 @@ NavState from_lcm(const nav_state_t& msg);
 
 target_state_t to_lcm(const TargetStateEstimate& state);
 TargetStateEstimate from_lcm(const target_state_t& msg);
+
+/// The covariance and velocity are not read (offline tools need the boxes).
+CameraTargetBox from_lcm(const target_box_t& msg);
 
 target_prediction_t to_lcm(const TargetPosePrediction& prediction);
 TargetPosePrediction from_lcm(const target_prediction_t& msg);

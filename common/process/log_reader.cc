@@ -68,6 +68,11 @@ void LogReader::on_metric_pose(const std::string& channel,
   subscribe<metric_object_pose_t>(channel, std::move(use), malformed);
 }
 
+void LogReader::on_target_box(const std::string& channel, std::function<void(const CameraTargetBox&)> use,
+                              int64_t* malformed) {
+  subscribe<target_box_t>(channel, std::move(use), malformed);
+}
+
 int64_t LogReader::read_all() {
   int64_t events = 0;
   while (const lcm::LogEvent* ev = log_->file.readNextEvent()) {

@@ -14,6 +14,7 @@
 #include "common/object/scale_estimator.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
+#include "common/types/target_box.h"
 #include "common/types/target_state.h"
 
 namespace vimot {
@@ -40,6 +41,9 @@ class LogReader {
   /// p_OinC is not in the message (left zero).
   void on_metric_pose(const std::string& channel, std::function<void(const scale::ObjectPoseInWorld&)> use,
                       int64_t* malformed);
+
+  void on_target_box(const std::string& channel, std::function<void(const CameraTargetBox&)> use,
+                     int64_t* malformed);
 
   /// Reads every event in order; returns how many there were.
   int64_t read_all();

@@ -1,5 +1,6 @@
 #include "common/segmentation/blob.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -28,6 +29,13 @@ std::optional<Blob> largest_blob(const cv::Mat& binary, int min_area_px) {
   b.area_px = stats.at<int>(best, cv::CC_STAT_AREA);
   b.num_blobs = n - 1;
   return b;
+}
+
+double box_iou(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
+  const double w = std::min(a(0) + a(2), b(0) + b(2)) - std::max(a(0), b(0));
+  const double h = std::min(a(1) + a(3), b(1) + b(3)) - std::max(a(1), b(1));
+  if (w <= 0.0 || h <= 0.0) return 0.0;
+  return w * h / (a(2) * a(3) + b(2) * b(3) - w * h);
 }
 
 }  // namespace vimot::segmentation

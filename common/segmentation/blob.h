@@ -23,4 +23,8 @@ struct Blob {
 /// blob that large. Throws std::invalid_argument unless CV_8UC1.
 std::optional<Blob> largest_blob(const cv::Mat& binary, int min_area_px);
 
+/// Intersection over union of two boxes [x_min, y_min, width, height]
+/// (0 when they do not overlap or one is empty).
+double box_iou(const Eigen::Vector4d& a, const Eigen::Vector4d& b);
+
 }  // namespace vimot::segmentation

@@ -192,5 +192,20 @@ cv::Mat TruthCorruptor::corrupt(int camera_id, const cv::Mat& true_mask) {
   return mask;
 }
 
+SegmenterOptions SegmenterOptions::from_config(const Config& cfg) {
+  SegmenterOptions o;
+  const std::string backend = cfg.get<std::string>("backend");
+  if (backend == "onnx") {
+    o.backend = Backend::kOnnx;
+    o.onnx = OnnxSegmenterOptions::from_config(cfg, "onnx");
+  } else if (backend == "truth") {
+    o.backend = Backend::kTruth;
+  } else {
+    cfg.fail("backend", "must be 'onnx' or 'truth', got '" + backend + "'");
+  }
+  o.truth = TruthCorruptionOptions::from_config(cfg, "truth");
+  return o;
+}
+
 }  // namespace segmentation
 }  // namespace vimot

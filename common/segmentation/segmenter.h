@@ -113,5 +113,19 @@ class TruthCorruptor {
   TruthCorruptionCounts counts_;
 };
 
+/// Which segmenter and its options: config/segmenter.yaml's `backend`,
+/// `onnx` (read only for backend onnx) and `truth` (read and checked
+/// whatever the backend, so a bad section never waits for the day the
+/// backend is switched).
+struct SegmenterOptions {
+  enum class Backend { kOnnx, kTruth };
+  Backend backend{Backend::kOnnx};
+  OnnxSegmenterOptions onnx;
+  TruthCorruptionOptions truth;
+
+  /// Throws ConfigError naming the key.
+  static SegmenterOptions from_config(const Config& cfg);
+};
+
 }  // namespace segmentation
 }  // namespace vimot

@@ -53,6 +53,10 @@ int run(int argc, const char* const* argv) {
   args.add_option("metric-channel", "CHANNEL", "metric_object_pose_t channel", "OBJECT_POSE_METRIC");
   args.add_option("object-state-channel", "CHANNEL", "target_state_t channel of the object motion filter",
                   "OBJECT_STATE");
+  args.add_option("box-channel", "CHANNEL",
+                  "target_box_t channel of the mask filter (e.g. TARGET_BOX): per camera, the frames with a\n"
+                  "valid filtered box and its IoU with the rendered simulator's true box of the same image");
+  args.add_option("box-truth-channel", "CHANNEL", "with --box-channel: the true boxes", "TARGET_BOX_TRUTH");
   args.add_option("json", "FILE", "write the summary as JSON (object \"summary\", as vimot-vio-eval's)");
   args.add_option("csv", "FILE", "write the per-sample errors with 3-sigma bounds (as vimot-vio-eval's)");
   args.add_option("compare", "SUMMARY_JSON", "print the relative difference to this summary (e.g. an offline run)");
@@ -70,6 +74,10 @@ int run(int argc, const char* const* argv) {
     opt.metric_channel = args.get("metric-channel");
     opt.object_state_channel = args.get("object-state-channel");
     opt.tracks = eval::read_track_truths(args.get("scale-truth"), 0);
+  }
+  if (args.given("box-channel")) {
+    opt.box_channel = args.get("box-channel");
+    opt.box_truth_channel = args.get("box-truth-channel");
   }
   if (args.given("compare-target") && opt.target_channel.empty()) {
     throw ArgError("--compare-target needs --target-channel");
@@ -120,6 +128,8 @@ int run(int argc, const char* const* argv) {
                 static_cast<long long>(tc.duplicate_states), static_cast<long long>(r.malformed_targets),
                 static_cast<long long>(tc.matched), static_cast<long long>(tc.unmatched),
                 static_cast<long long>(tc.bad_covariance));
+    std::printf("target kept: %lld of %lld updated states from the first target state on have one\n",
+                static_cast<long long>(r.frames_with_target), static_cast<long long>(r.frames_since_target_start));
     if (opt.target_own_frame) {
       std::printf("target frame (filter's in the true one, fixed at its first state): %s\n",
                   r.target_samples.target_frame.describe().c_str());
@@ -138,6 +148,19 @@ int run(int argc, const char* const* argv) {
     }
   }
 
+  for (std::size_t cam = 0; cam < r.boxes.size(); ++cam) {
+    const eval::BoxCameraFigures& b = r.boxes[cam];
+    if (b.truth_frames == 0 && b.boxes == 0) continue;
+    std::printf("box camera %zu on %s: %lld boxes for %lld true (target visible %lld, no box %lld, malformed %lld); "
+                "kept %lld of %lld visible, filtered valid %lld, detections %lld, box without target %lld, "
+                "longest coast %d frames; IoU with the truth mean %.3f min %.3f (< 0.5: %lld)\n",
+                cam, opt.box_channel.c_str(), static_cast<long long>(b.boxes), static_cast<long long>(b.truth_frames),
+                static_cast<long long>(b.truth_visible), static_cast<long long>(b.missing),
+                static_cast<long long>(r.malformed_boxes), static_cast<long long>(b.kept),
+                static_cast<long long>(b.truth_visible), static_cast<long long>(b.filtered_valid),
+                static_cast<long long>(b.raw_valid), static_cast<long long>(b.false_boxes), b.max_coasted, b.mean_iou,
+                b.min_iou, static_cast<long long>(b.low_iou));
+  }
   if (!opt.scale_channel.empty()) {
     const eval::ScaleFigures& f = r.scale;
     const eval::AbsStats a = eval::abs_stats(f.accepted_scale_errors);

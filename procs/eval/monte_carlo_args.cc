@@ -20,6 +20,10 @@ void add_monte_carlo_args(ArgParser& args, const std::string& runs_help, const s
   args.add_option("pixels", "FILE",
                   "frames from pixels: the rendered images through the feature tracker, configured\n"
                   "by FILE's tracker: section (e.g. config/feature_tracker_sim.yaml), target box = truth");
+  args.add_option("segmenter", "FILE",
+                  "with --pixels: the target box from the segmenter configured by FILE\n"
+                  "(config/segmenter.yaml) and the mask filter of --mask-filter, not the truth");
+  args.add_option("mask-filter", "FILE", "with --segmenter: the mask filter's config (config/mask_filter.yaml)");
 }
 
 MonteCarloArgs read_monte_carlo_args(const ArgParser& args) {
@@ -41,6 +45,11 @@ MonteCarloArgs read_monte_carlo_args(const ArgParser& args) {
   }
   if (args.given("pixels")) {
     a.pixels = frontend::FeatureTrackerOptions::from_config(Config::load_file(args.get("pixels")), "tracker");
+  }
+  if (args.given("segmenter") != args.given("mask-filter")) throw ArgError("--segmenter and --mask-filter go together");
+  if (args.given("segmenter")) {
+    if (!a.pixels) throw ArgError("--segmenter needs --pixels (it segments the rendered images)");
+    a.box_chain = segmentation::BoxChainOptions::from_config_files(args.get("segmenter"), args.get("mask-filter"));
   }
   return a;
 }

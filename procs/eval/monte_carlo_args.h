@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/frontend/tracker_options.h"
+#include "common/segmentation/box_chain.h"
 #include "common/process/arg_parser.h"
 
 namespace vimot {
@@ -26,6 +27,9 @@ struct MonteCarloArgs {
   /// --pixels FILE: frames from rendered images through the feature tracker,
   /// its options from FILE's `tracker:` section (the feature_tracker process's config).
   std::optional<frontend::FeatureTrackerOptions> pixels;
+  /// --segmenter FILE --mask-filter FILE (with --pixels): the target box
+  /// from the segmenter and the mask filter instead of the truth.
+  std::optional<segmentation::BoxChainOptions> box_chain;
 };
 
 /// Reads and checks them after ArgParser::parse. Throws ArgError naming the

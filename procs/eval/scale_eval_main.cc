@@ -91,6 +91,7 @@ int run(int argc, const char* const* argv) {
   options.tracker = object_tracker_options_from_config(Config::load_file(args.get("tracker-config")));
   options.node = scale_node_options_from_config(Config::load_file(args.get("scale-config")));
   options.pixels = mca.pixels;
+  options.box_chain = mca.box_chain;
 
   const long long runs = mca.runs;
   const long long first = static_cast<long long>(mca.first_seed);

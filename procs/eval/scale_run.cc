@@ -44,7 +44,7 @@ ScaleRunResult run_scale_on_sim(const sim::SimConfig& sim_config, const ScaleEva
 
   estimator::VioEstimator est(options.vio);
   std::optional<PixelFrontEnd> pixels;
-  if (options.pixels) pixels.emplace(sim, *options.pixels);
+  if (options.pixels) pixels.emplace(sim, *options.pixels, options.box_chain);
   const estimator::InitialEstimate x0 = estimator::initial_estimate(sim.initial_state(), options.vio, perturb_seed);
   est.initialize(x0.value, sim.initial_state().utime, x0.P0);
   // The tracker's pose of the current frame (the node publishes one per

@@ -14,6 +14,7 @@
 #include "common/eval/scale_eval.h"
 #include "common/frontend/tracker_options.h"
 #include "common/object/object_tracker.h"
+#include "common/segmentation/box_chain.h"
 #include "common/sim/sim_config.h"
 #include "procs/scale_estimator/scale_node.h"
 
@@ -27,6 +28,8 @@ struct ScaleEvalOptions {
   /// Set: frames from pixels (common/eval/pixel_frontend.h) instead of the
   /// simulated tracks.
   std::optional<frontend::FeatureTrackerOptions> pixels;
+  /// With pixels: the target box from the segmenter and mask filter.
+  std::optional<segmentation::BoxChainOptions> box_chain;
 };
 
 /// One run on `sim_config` (mono scenario with a target). perturb_seed 0 =

@@ -164,6 +164,7 @@ int run(int argc, const char* const* argv) {
   o.threads = mca.threads;
   o.fixed_perturb_seed = mca.perturb_seed;
   o.pixels = mca.pixels;
+  o.box_chain = mca.box_chain;
   const std::size_t n_cells =
       (o.vio_only ? 1 : 0) + o.sigmas.size() * o.modes.size() * o.representations.size();
   if (n_cells == 0) throw ArgError("nothing to run (empty --sigmas/--modes/--representations and --no-vio-only)");
@@ -186,7 +187,8 @@ int run(int argc, const char* const* argv) {
             << o.threads << " threads (" << eval::hms(wall * o.threads / static_cast<double>(n_cells * o.runs))
             << " per run and thread); machine: " << machine.nproc << " CPUs, " << machine.cpu_model << "\n";
   std::cout << "target start: " << target::to_string(base_filter.init_mode) << "; frames "
-            << (o.pixels ? "from pixels (" + args.get("pixels") + ", true target box)" : std::string("simulated features"))
+            << (o.pixels ? "from pixels (" + args.get("pixels") +
+                            (o.box_chain ? ", target box from the segmenter and mask filter)" : ", true target box)") : std::string("simulated features"))
             << "\n";
   if (n_cells * static_cast<std::size_t>(o.runs) > 12) {
     std::cout << "  (each run's target tracking and target frame transform: summary.json, per_run)\n";

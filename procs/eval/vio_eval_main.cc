@@ -76,6 +76,7 @@ int run(int argc, const char* const* argv) {
   const std::string out_dir = args.get("out");
   mc.keep_samples = !out_dir.empty();
   mc.pixels = mca.pixels;
+  mc.box_chain = mca.box_chain;
   if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
 
   log_info("scenario ", sim::to_string(sim_cfg.scenario), " (", sim_path, "), estimator ", vins_path, ": ", mc.runs,

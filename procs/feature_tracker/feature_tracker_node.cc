@@ -15,7 +15,7 @@ constexpr std::size_t kMaxStoredBoxes = 16;
 
 FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& cfg) {
   const std::vector<std::string> allowed{"calibration_file", "mode", "tracker", "node", "channels", "comment"};
-  const std::vector<std::string> node_keys{"max_pending_images", "box_max_age_s", "wait_for_box"};
+  const std::vector<std::string> node_keys{"max_pending_images", "box_max_age_s", "wait_for_box", "box_wait_frames"};
   for (const std::string& k : cfg.keys()) {
     if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
       cfg.fail(k, "is unknown (expected calibration_file, mode, tracker, node, channels, comment)");
@@ -24,7 +24,7 @@ FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& c
   if (cfg.has("node")) {
     for (const std::string& k : cfg.sub("node").keys()) {
       if (std::find(node_keys.begin(), node_keys.end(), k) == node_keys.end()) {
-        cfg.fail("node." + k, "is unknown (expected max_pending_images, box_max_age_s, wait_for_box)");
+        cfg.fail("node." + k, "is unknown (expected max_pending_images, box_max_age_s, wait_for_box, box_wait_frames)");
       }
     }
   }
@@ -39,6 +39,8 @@ FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& c
   o.max_pending_images = cfg.get_or<int>("node.max_pending_images", o.max_pending_images);
   if (o.max_pending_images < 1) cfg.fail("node.max_pending_images", "must be >= 1");
   o.wait_for_box = cfg.get_or<bool>("node.wait_for_box", o.wait_for_box);
+  o.box_wait_frames = cfg.get_or<int>("node.box_wait_frames", o.box_wait_frames);
+  if (o.box_wait_frames < 1) cfg.fail("node.box_wait_frames", "must be >= 1");
   o.box_max_age_s = cfg.get_or<double>("node.box_max_age_s", o.box_max_age_s);
   if (o.box_max_age_s < 0.0) cfg.fail("node.box_max_age_s", "must be >= 0");
   return o;
@@ -153,14 +155,15 @@ void FeatureTrackerNode::frame_ready(int64_t utime, const cv::Mat& left, const c
 }
 
 void FeatureTrackerNode::release_ready() {
-  // A frame waits for its boxes; once a later frame is complete too, the
-  // boxes of the earlier one are taken as missing (the box source skipped
-  // it) so a silent box channel delays the output by one frame, no more.
+  // A frame waits for its boxes; once box_wait_frames later frames are
+  // complete too, the boxes of the earlier one are taken as missing (the
+  // box source skipped it) so a silent box channel delays the output by
+  // that many frames, no more.
   while (!ready_.empty()) {
     const auto it = ready_.begin();
     bool boxes_in = true;
     for (std::size_t c = 0; c < options_.cameras.size(); ++c) boxes_in = boxes_in && boxes_[c].count(it->first) != 0;
-    if (!boxes_in && ready_.size() < 2) return;
+    if (!boxes_in && ready_.size() <= static_cast<std::size_t>(options_.box_wait_frames)) return;
     const auto [left, right] = it->second;
     const int64_t utime = it->first;
     ready_.erase(it);

@@ -45,6 +45,10 @@ struct FeatureTrackerNodeOptions {
   /// Hold each frame for its boxes (a box source runs: mask filter, the
   /// simulator's truth box); false: track as soon as the images are there.
   bool wait_for_box{false};
+  /// With wait_for_box: a frame goes out without its missing boxes once
+  /// this many later frames are complete (>= 1; a slow box source such as
+  /// the segmentation network needs more than one frame).
+  int box_wait_frames{1};
 
   /// From a feature tracker config (config/feature_tracker.yaml):
   /// calibration_file (cameras.cam0/cam1, relative to the file), mode

@@ -10,18 +10,7 @@ namespace vimot {
 SegmenterNodeOptions SegmenterNodeOptions::from_config(const Config& cfg) {
   cfg.check_keys("", {"backend", "mode", "image_width", "image_height", "onnx", "truth", "channels", "comment"});
   SegmenterNodeOptions o;
-  const std::string backend = cfg.get<std::string>("backend");
-  if (backend == "onnx") {
-    o.backend = Backend::kOnnx;
-    o.onnx = segmentation::OnnxSegmenterOptions::from_config(cfg, "onnx");
-  } else if (backend == "truth") {
-    o.backend = Backend::kTruth;
-  } else {
-    cfg.fail("backend", "must be 'onnx' or 'truth', got '" + backend + "'");
-  }
-  // Read (and checked) whatever the backend, so a bad section never waits
-  // for the day the backend is switched.
-  o.truth = segmentation::TruthCorruptionOptions::from_config(cfg, "truth");
+  static_cast<segmentation::SegmenterOptions&>(o) = segmentation::SegmenterOptions::from_config(cfg);
   const std::string mode = cfg.get_or<std::string>("mode", "stereo");
   if (mode != "stereo" && mode != "mono") cfg.fail("mode", "must be 'stereo' or 'mono', got '" + mode + "'");
   o.cameras = mode == "stereo" ? 2 : 1;

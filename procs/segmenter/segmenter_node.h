@@ -18,11 +18,8 @@ namespace vimot {
 
 class Config;
 
-struct SegmenterNodeOptions {
-  enum class Backend { kOnnx, kTruth };
-  Backend backend{Backend::kOnnx};
-  segmentation::OnnxSegmenterOptions onnx;
-  segmentation::TruthCorruptionOptions truth;
+/// The segmenter (backend, onnx, truth) and the process's input checks.
+struct SegmenterNodeOptions : segmentation::SegmenterOptions {
   int cameras{2};  // stereo 2, mono 1
   /// px; every image / true mask must have this size.
   int image_width{752};

@@ -161,6 +161,37 @@ TEST_CASE("with wait_for_box a frame waits for its boxes, or for the next frame 
   CHECK(node.errors() == 0);
 }
 
+TEST_CASE("with box_wait_frames a frame waits that many later frames for boxes that come late") {
+  Recorder r;
+  FeatureTrackerNodeOptions o = options(2);
+  o.wait_for_box = true;
+  o.box_wait_frames = 2;
+  FeatureTrackerNode node = make_node(o, r);
+  const cv::Mat image = test::make_texture(320, 240, 55, 400);
+  const frontend::Box box{100.0, 60.0, 120.0, 100.0};
+  for (int64_t t : {1000000, 2000000}) {
+    node.on_image(0, t, image);
+    node.on_image(1, t, image);
+  }
+  CHECK(r.frames.empty());  // one later frame is complete: the 1 s frame still waits (box_wait_frames 1 would not)
+  node.on_box(0, 1000000, box);
+  node.on_box(1, 1000000, box);
+  REQUIRE(r.frames.size() == 1);  // its boxes came after the next frame's images and are used
+  int targets = 0;
+  for (const FeatureObservation& f : r.frames[0].observations) targets += f.is_target ? 1 : 0;
+  CHECK(targets > 0);
+  // The 2 s frame's boxes never come: it goes out once two later frames are complete.
+  for (int64_t t : {3000000, 4000000}) {
+    CHECK(r.frames.size() == 1);
+    node.on_image(0, t, image);
+    node.on_image(1, t, image);
+  }
+  REQUIRE(r.frames.size() == 2);
+  CHECK(r.frames[1].utime == 2000000);
+  for (const FeatureObservation& f : r.frames[1].observations) CHECK_FALSE(f.is_target);
+  CHECK(node.errors() == 0);
+}
+
 TEST_CASE("FeatureTrackerNodeOptions reads config/feature_tracker.yaml and refuses unknown keys") {
   const Config cfg = Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/feature_tracker.yaml");
   const FeatureTrackerNodeOptions o = FeatureTrackerNodeOptions::from_config(cfg);

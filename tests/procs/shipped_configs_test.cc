@@ -57,8 +57,14 @@ void load_with_its_reader(const std::string& name, const std::string& path) {
   } else if (name.rfind("segmenter", 0) == 0) {
     const SegmenterNodeOptions o = SegmenterNodeOptions::from_config(cfg);
     CHECK(o.cameras == (mono ? 1 : 2));
-    CHECK(o.backend == SegmenterNodeOptions::Backend::kOnnx);
-    CHECK(o.onnx.model_file == source_path("config/models/segmenter_unet.onnx"));
+    if (name == "segmenter_truth.yaml") {
+      CHECK(o.backend == SegmenterNodeOptions::Backend::kTruth);
+      CHECK(o.truth.dropout_frames >= 5);  // the corruption the issue asks the chain to survive
+      CHECK(o.truth.false_blob_rate > 0.0);
+    } else {
+      CHECK(o.backend == SegmenterNodeOptions::Backend::kOnnx);
+      CHECK(o.onnx.model_file == source_path("config/models/segmenter_unet.onnx"));
+    }
   } else if (name.rfind("target_filter", 0) == 0) {
     const TargetFilterNodeOptions o = node_options_from_config(cfg);
     CHECK(o.target_enabled);

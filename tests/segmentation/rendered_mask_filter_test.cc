@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/config/config.h"
+#include "common/segmentation/blob.h"
 #include "common/segmentation/mask_filter.h"
 #include "common/sim/renderer.h"
 #include "common/sim/sim_config.h"
@@ -21,13 +22,6 @@ using namespace vimot;
 namespace {
 
 std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
-
-double iou(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
-  const double w = std::min(a(0) + a(2), b(0) + b(2)) - std::max(a(0), b(0));
-  const double h = std::min(a(1) + a(3), b(1) + b(3)) - std::max(a(1), b(1));
-  if (w <= 0.0 || h <= 0.0) return 0.0;
-  return w * h / (a(2) * a(3) + b(2) * b(3) - w * h);
-}
 
 bool in_dropout(int k) { return (k >= 15 && k < 21) || (k >= 35 && k < 43); }
 
@@ -96,7 +90,7 @@ TEST_CASE("mask filter: rendered paper-scenario masks with false blobs and dropo
         // The largest blob after the opening is the target; the opening
         // only shaves its acute corners, by less than the kernel.
         CHECK((e.raw_box - truth).cwiseAbs().maxCoeff() < options.morphology.erode_kernel_px);
-        worst_iou = std::min(worst_iou, iou(e.filtered_box, truth));
+        worst_iou = std::min(worst_iou, segmentation::box_iou(e.filtered_box, truth));
       }
     }
   }

@@ -23,10 +23,10 @@ std::string source_path(const std::string& relative) { return std::string(VIMOT_
 
 // The configs the test cases below check; a .pmd in the folder but not
 // here fails.
-const std::set<std::string> kChecked = {"sim_demo.pmd",    "sim_mono.pmd",      "euroc.pmd",
-                                        "sim_pixels.pmd",  "two_hosts.pmd",     "live_stereo.pmd",
-                                        "live_mono.pmd",   "log_playback.pmd",  "two_hosts_live.pmd",
-                                        "sim_mono_pixels.pmd"};
+const std::set<std::string> kChecked = {"sim_demo.pmd",      "sim_mono.pmd",          "euroc.pmd",
+                                        "sim_pixels.pmd",    "sim_segmented.pmd",     "sim_mono_segmented.pmd",
+                                        "two_hosts.pmd",     "live_stereo.pmd",       "live_mono.pmd",
+                                        "log_playback.pmd",  "two_hosts_live.pmd",    "sim_mono_pixels.pmd"};
 
 void check_config(const std::string& pmd, const std::vector<std::string>& expected_commands,
                   const std::vector<std::string>& config_files) {
@@ -61,6 +61,14 @@ TEST_CASE("shipped sheriff configs parse") {
                {"vins_euroc.yaml", "feature_tracker.yaml"});
   check_config("sim_pixels.pmd", {"logger", "vins", "target_filter", "feature_tracker", "sim"},
                {"target_filter.yaml"});
+  check_config("sim_segmented.pmd",
+               {"logger", "vins", "target_filter", "segmenter", "mask_filter", "feature_tracker", "sim"},
+               {"target_filter.yaml"});
+  check_config("sim_mono_segmented.pmd",
+               {"logger", "vins", "object_tracker", "scale_estimator", "segmenter", "mask_filter", "feature_tracker",
+                "sim"},
+               {"vins_mono.yaml", "object_tracker.yaml", "scale_estimator.yaml", "segmenter_mono.yaml",
+                "mask_filter_mono.yaml", "feature_tracker_segmented_mono.yaml"});
   // Onboard the target filter is the VIO: no vins beside it.
   check_config("live_stereo.pmd",
                {"logger", "target_filter", "feature_tracker", "segmenter", "mask_filter", "imu", "camera"},
