@@ -51,7 +51,7 @@ mkdir -p "$(dirname "$out")"
 # lcm-logger matches -c against the whole channel name.
 args=(--quiet)
 if [ $invert -eq 1 ]; then args+=(-c "$exclude" -v); else args+=(-c "$regex"); fi
-[ -n "$url" ] && args+=(-l "$url")
+[ -n "$url" ] && args+=("--lcm-url=$url")
 echo "record.sh: writing $out" >&2
 if [ -n "$duration" ]; then
   # SIGINT: lcm-logger closes the log cleanly.

@@ -80,6 +80,6 @@ else
   factor="$speed"
 fi
 args=(-s "$factor" -e "$regex")
-[ -n "$url" ] && args+=(-l "$url")
+[ -n "$url" ] && args+=("--lcm-url=$url")
 echo "replay.sh: $log was recorded at ${recorded}x; playing channels $regex at ${speed}x (lcm-logplayer -s $factor)" >&2
 exec lcm-logplayer "${args[@]}" "$log"

@@ -5,6 +5,7 @@
 // TARGET_PREDICTION is reproduced byte for byte. Then scripts/replay.sh
 // plays the log at a chosen speed whatever speed it was recorded at.
 // Exits 77 (ctest: skipped) when UDP multicast does not work here.
+#define CATCH_CONFIG_RUNNER
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
@@ -97,6 +98,7 @@ const std::string& live_log() {
 /// The last heartbeat of each process in a log.
 std::map<std::string, vimot::heartbeat_t> last_heartbeats(const std::string& path) {
   lcm::LogFile log(path, "r");
+  REQUIRE(log.good());
   std::map<std::string, vimot::heartbeat_t> beats;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     vimot::heartbeat_t hb;
@@ -107,6 +109,7 @@ std::map<std::string, vimot::heartbeat_t> last_heartbeats(const std::string& pat
 
 int64_t count_on(const std::string& path, const std::string& channel) {
   lcm::LogFile log(path, "r");
+  REQUIRE(log.good());
   int64_t n = 0;
   while (const lcm::LogEvent* ev = log.readNextEvent()) n += ev->channel == channel;
   return n;
@@ -190,28 +193,32 @@ TEST_CASE("replay.sh plays a log at the asked speed whatever speed it was record
   CHECK(recorded_speed(log) == Approx(1.0).epsilon(0.05));
   const int64_t imu = count_on(log, "IMU");
   REQUIRE(imu == 1601);
-  // Played at 3x and re-recorded: a log recorded at 3x, nothing lost.
-  const std::string at3 = replay_and_record(log, 3.0, 5.0, "at3");
+  // Played at 2x and re-recorded: a log recorded at 2x, nothing lost.
+  const std::string at2 = replay_and_record(log, 2.0, 6.5, "at2");
+  CHECK(recorded_speed(at2) == Approx(2.0).epsilon(0.1));
+  CHECK(count_on(at2, "IMU") == imu);
+  CHECK(count_on(at2, "VINS_STATE") == 0);  // estimates are not replayed
+  // That 2x log at 3x: lcm-logplayer -s 1.5, not 3 (which would play at 6x).
+  // (Faster plays lose UDP messages on a loaded 2-core machine.)
+  const std::string at3 = replay_and_record(at2, 3.0, 5.0, "at3");
   CHECK(recorded_speed(at3) == Approx(3.0).epsilon(0.1));
   CHECK(count_on(at3, "IMU") == imu);
-  CHECK(count_on(at3, "VINS_STATE") == 0);  // estimates are not replayed
-  // That 3x log at 6x: lcm-logplayer -s 2, not 6 (which would play at 18x).
-  const std::string at6 = replay_and_record(at3, 6.0, 4.0, "at6");
-  CHECK(recorded_speed(at6) == Approx(6.0).epsilon(0.1));
-  CHECK(count_on(at6, "IMU") == imu);
 }
 
 int main(int argc, char* argv[]) {
   // UDP multicast on loopback (absent in some containers): one message to ourselves.
+  struct Probe {
+    bool heard{false};
+    void on(const lcm::ReceiveBuffer*, const std::string&) { heard = true; }
+  } probe;
   lcm::LCM lcm(kUrl);
-  bool heard = false;
   if (lcm.good()) {
-    lcm.subscribe("RECORD_REPLAY_PROBE", [&heard](const lcm::ReceiveBuffer*, const std::string&) { heard = true; });
-    vimot::imu_t probe{};
-    lcm.publish("RECORD_REPLAY_PROBE", &probe);
+    lcm.subscribe("RECORD_REPLAY_PROBE", &Probe::on, &probe);
+    const vimot::imu_t message{};
+    lcm.publish("RECORD_REPLAY_PROBE", &message);
     lcm.handleTimeout(1000);
   }
-  if (!heard) {
+  if (!probe.heard) {
     std::cout << "UDP multicast on " << kUrl << " does not work here: skipping the record/replay test\n";
     return kSkip;
   }
