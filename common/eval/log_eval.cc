@@ -36,9 +36,18 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   std::map<int64_t, GroundTruth> target_truths;  // for the metric poses
   // A channel keeps its first handler: the state channel wins over the
   // others, the truth channel is the last resort (as the channels are meant).
-  log.on_nav_state(options.state_channel, [&](const NavState& x) { matcher.add_state(x); }, &r.malformed_states);
-  log.on_target_state(options.target_channel, [&](const TargetStateEstimate& x) { matcher.add_target(x); },
-                      &r.malformed_targets);
+  log.on_nav_state(
+      options.state_channel,
+      [&](const NavState& x) {
+        if (x.utime >= options.from_utime) matcher.add_state(x);
+      },
+      &r.malformed_states);
+  log.on_target_state(
+      options.target_channel,
+      [&](const TargetStateEstimate& x) {
+        if (x.utime >= options.from_utime) matcher.add_target(x);
+      },
+      &r.malformed_targets);
   if (scale_on) {
     log.on_scale_estimate(options.scale_channel, [&](const scale::ScaleResult& x) { estimates.push_back(x); },
                           &r.malformed_scale);

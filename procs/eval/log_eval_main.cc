@@ -45,6 +45,9 @@ int run(int argc, const char* const* argv) {
                   "with --own-target-frame: target states more than SECONDS apart mean the filter started its\n"
                   "target again (a respawned process, a reset) in a new frame of its own, taken again at its\n"
                   "first state after the gap (default: taken once)");
+  args.add_option("from-utime", "UTIME",
+                  "evaluate only the states (and target states) at or after this utime, e.g. those of a\n"
+                  "process restarted mid-run (its \"initialised from ground truth at utime N\")");
   args.add_option("compare-target", "SUMMARY_JSON",
                   "with --target-channel: print the relative difference of the target figures to a\n"
                   "one-run vimot-target-eval summary.json (its first target-filter cell)");
@@ -73,6 +76,10 @@ int run(int argc, const char* const* argv) {
     if (!opt.target_own_frame) throw ArgError("vimot-log-eval: --target-restart-gap needs --own-target-frame");
     opt.target_restart_gap_s = args.get_double("target-restart-gap");
     if (!(opt.target_restart_gap_s > 0.0)) throw ArgError("vimot-log-eval: --target-restart-gap must be > 0");
+  }
+  if (args.given("from-utime")) {
+    opt.from_utime = args.get_int("from-utime");
+    if (opt.from_utime < 0) throw ArgError("vimot-log-eval: --from-utime must be >= 0");
   }
   if (args.given("scale-truth")) {
     opt.scale_channel = args.get("scale-channel");

@@ -35,6 +35,10 @@ class Outputs {
     if (sink_) sink_->write(channel, msg.utime, bytes.data(), static_cast<int>(bytes.size()));
     by_channel[channel].push_back(std::move(bytes));
   }
+  /// A logged message copied into the output log (the ground truth).
+  void copy(const std::string& channel, int64_t utime, const void* data, int size) {
+    if (sink_) sink_->write(channel, utime, data, size);
+  }
   std::map<std::string, std::vector<Bytes>> by_channel;
 
  private:
@@ -71,6 +75,7 @@ struct Replay {
   std::map<std::string, std::vector<InputHandler>> inputs;
   std::vector<std::string> output_channels;
   std::string imu_channel;
+  std::string truth_channel;  // copied to the output log
 };
 
 }  // namespace
@@ -108,6 +113,7 @@ ReplayReport replay_log(const std::string& log_path, const ReplaySetup& setup) {
         options, [&outputs, state](const NavState& s) { outputs.add(state, to_lcm(s)); }, on_event);
     VinsNode& node = *r.vins;
     r.imu_channel = channel_of(cfg, "imu", "IMU");
+    r.truth_channel = channel_of(cfg, "ground_truth", "GROUND_TRUTH");
     r.inputs[r.imu_channel].push_back(input<imu_t>([&node](const ImuData& m) { node.on_imu(m); }));
     r.inputs[channel_of(cfg, "features", "FEATURES")].push_back(
         input<features_t>([&node](const CameraFrame& m) { node.on_frame(m); }));
@@ -136,6 +142,7 @@ ReplayReport replay_log(const std::string& log_path, const ReplaySetup& setup) {
     TargetFilterNode& node = *r.target;
     const std::string imu = channel_of(cfg, "imu", "IMU");
     if (r.imu_channel.empty()) r.imu_channel = imu;
+    if (r.truth_channel.empty()) r.truth_channel = channel_of(cfg, "ground_truth", "GROUND_TRUTH");
     r.inputs[imu].push_back(input<imu_t>([&node](const ImuData& m) { node.on_imu(m); }));
     r.inputs[channel_of(cfg, "features", "FEATURES")].push_back(
         input<features_t>([&node](const CameraFrame& m) { node.on_frame(m); }));
@@ -155,7 +162,10 @@ ReplayReport replay_log(const std::string& log_path, const ReplaySetup& setup) {
   const double cpu_start_ms = thread_cpu_ms();
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++report.events;
+    const int64_t utime = vimot_message_utime(ev->data, ev->datalen);
+    if (ev->channel == r.truth_channel) outputs.copy(ev->channel, utime, ev->data, ev->datalen);
     const auto in = r.inputs.find(ev->channel);
+    if (in != r.inputs.end() && utime < setup.from_utime) continue;
     if (in != r.inputs.end()) {
       ++report.inputs;
       for (const InputHandler& handle : in->second) {
@@ -164,14 +174,14 @@ ReplayReport replay_log(const std::string& log_path, const ReplaySetup& setup) {
           break;  // the same bytes are malformed for every Node
         }
       }
-      if (ev->channel == r.imu_channel && ev->datalen >= 16) {
-        if (first_imu < 0) first_imu = vimot_message_utime(ev->data, ev->datalen);
-        last_imu = vimot_message_utime(ev->data, ev->datalen);
+      if (ev->channel == r.imu_channel && utime >= 0) {
+        if (first_imu < 0) first_imu = utime;
+        last_imu = utime;
       }
       continue;
     }
     const auto out = recorded.find(ev->channel);
-    if (out != recorded.end()) {
+    if (out != recorded.end() && utime >= setup.from_utime) {
       const auto* data = static_cast<const uint8_t*>(ev->data);
       out->second.emplace_back(data, data + ev->datalen);
     }

@@ -25,11 +25,18 @@ struct ReplaySetup {
   std::string target_filter_config;
   /// Overrides the configs' init.perturb_seed (as the processes' --perturb-seed); < 0: keep.
   int64_t perturb_seed{-1};
-  /// Write the replayed outputs to this LCM log (event time = utime); empty: none.
+  /// Write the replayed outputs, with the log's ground truth (channel of the
+  /// first process's config), to this LCM log (event time = utime), which
+  /// vimot-log-eval evaluates as a live run's; empty: none.
   std::string out_log;
+  /// Inputs before this utime are not fed: the Nodes start as a process
+  /// started at that point of the run would (e.g. a fresh start to compare
+  /// a respawned process with); 0: from the beginning.
+  int64_t from_utime{0};
 };
 
-/// One output channel: the live run's messages against the replay's, in order.
+/// One output channel: the live run's messages against the replay's, in order
+/// (with from_utime: only the recorded messages at or after it).
 struct ChannelComparison {
   std::string channel;
   int64_t recorded{0};

@@ -25,7 +25,12 @@ int run(int argc, const char* const* argv) {
   args.add_option("vins", "CONFIG", "replay vins with this config (e.g. config/vins.yaml)");
   args.add_option("target-filter", "CONFIG", "replay target_filter with this config (e.g. config/target_filter.yaml)");
   args.add_option("perturb-seed", "N", "as the processes' --perturb-seed (overrides init.perturb_seed)");
-  args.add_option("out", "FILE", "write the replayed outputs to this LCM log (event time = utime)");
+  args.add_option("out", "FILE",
+                  "write the replayed outputs and the log's ground truth to this LCM log (event time = utime),\n"
+                  "for vimot-log-eval");
+  args.add_option("from-utime", "UTIME",
+                  "feed only the inputs at or after this utime: the Nodes start as a process started then\n"
+                  "would (compare only the recorded outputs from there)");
   if (!args.parse(argc, argv)) return 0;
 
   vimot::ReplaySetup setup;
@@ -40,6 +45,10 @@ int run(int argc, const char* const* argv) {
     setup.perturb_seed = seed;
   }
   if (args.given("out")) setup.out_log = args.get("out");
+  if (args.given("from-utime")) {
+    setup.from_utime = args.get_int("from-utime");
+    if (setup.from_utime < 0) throw vimot::ArgError("vimot-log-replay: --from-utime must be >= 0");
+  }
 
   const vimot::ReplayReport report = vimot::replay_log(args.positionals()[0], setup);
   std::cout << "replayed " << report.inputs << " inputs of " << report.events << " log events ("
