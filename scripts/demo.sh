@@ -142,7 +142,7 @@ if [ $pipeline = mono ]; then
     | grep -E '^(scale|metric|filtered|compare|  (scale|accepted|last|object|filtered))' | sed 's/^/   /'
   echo "   (offline run: $out/offline_scale.txt)"
   echo "== log: $VIMOT_LOG"
-  echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
+  echo "   replay: scripts/replay.sh $VIMOT_LOG [--offline]    watch: scripts/lcm-spy.sh"
   finish
 fi
 echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal VINS_STATE):"
@@ -170,5 +170,5 @@ if [ "$target_status" -ne 0 ] && [ "$lcm_vs_offline" -eq 0 ]; then
 fi
 echo "   (offline target run: $out/offline_target.txt)"
 echo "== log: $VIMOT_LOG"
-echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
+echo "   replay: scripts/replay.sh $VIMOT_LOG [--offline]    watch: scripts/lcm-spy.sh"
 finish
