@@ -101,6 +101,7 @@ run() {
   mkdir -p "$dir"
   export VIMOT_LOG="$dir/run.lcmlog"
   local sheriff deputy=""
+  : > "$dir/sheriff.txt"
   if [ $mode = local ]; then
     "$bin/vimot-sheriff" --script run --exit-when sim --duration "$cap" "$pmd" > "$dir/sheriff.txt" 2>&1 &
     sheriff=$!
@@ -170,14 +171,6 @@ check() {  # check TEXT COMMAND...: ok if COMMAND succeeds
 }
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && b != "" && a + 0 <= b + 0) }'; }
 
-echo "== kill and recover ($mode), $VIMOT_SIM_CONFIG at ${VIMOT_SPEED}x, seed $VIMOT_SEED, kill at ${kill_at} s; output in $out"
-echo "== undisturbed run"
-run undisturbed
-for ch in VINS_STATE NAV_STATE TARGET_STATE; do
-  echo "   $ch position RMSE $(metric $ch "$out/undisturbed") m, longest silence $(gap "$out/undisturbed" $ch) s"
-done
-echo "   TARGET_STATE target in the IMU frame: position RMSE $(metric TARGET_IN_IMU "$out/undisturbed") m"
-echo "   IMU/FEATURES messages lost under load:$(losses "$out/undisturbed")"
 # Input the estimators lost (UDP under load; their "stopping:" lines): a
 # run that lost input is not the stack's undisturbed accuracy.
 losses() {
@@ -188,6 +181,14 @@ losses() {
   done
 }
 
+echo "== kill and recover ($mode), $VIMOT_SIM_CONFIG at ${VIMOT_SPEED}x, seed $VIMOT_SEED, kill at ${kill_at} s; output in $out"
+echo "== undisturbed run"
+run undisturbed
+for ch in VINS_STATE NAV_STATE TARGET_STATE; do
+  echo "   $ch position RMSE $(metric $ch "$out/undisturbed") m, longest silence $(gap "$out/undisturbed" $ch) s"
+done
+echo "   TARGET_STATE target in the IMU frame: position RMSE $(metric TARGET_IN_IMU "$out/undisturbed") m"
+echo "   IMU/FEATURES messages lost under load:$(losses "$out/undisturbed")"
 # The utime a restarted process last initialised at (its log line), empty if none.
 init_utime() {
   grep -E "^\[([^]]*:)?$2\] .*initialised from ground truth at utime [0-9]+" "$1/sheriff.txt" | tail -n 1 |
