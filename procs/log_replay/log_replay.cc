@@ -199,15 +199,22 @@ ReplayReport replay_log(const std::string& log_path, const ReplaySetup& setup) {
     c.channel = name;
     c.recorded = static_cast<int64_t>(live.size());
     c.replayed = static_cast<int64_t>(replayed.size());
-    const std::size_t n = std::min(live.size(), replayed.size());
-    for (std::size_t i = 0; i < n; ++i) {
-      if (live[i] == replayed[i]) {
-        ++c.identical;
-      } else if (c.first_difference < 0) {
+    // In order; a replayed message the log lacks (lcm-logger lost it under
+    // load) is passed over when the recorded one follows within a few.
+    constexpr std::size_t kLookahead = 50;
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < live.size(); ++i) {
+      std::size_t k = j;
+      while (k < replayed.size() && k < j + kLookahead && replayed[k] != live[i]) ++k;
+      if (k == replayed.size() || k == j + kLookahead) {
         c.first_difference = static_cast<int64_t>(i);
+        break;
       }
+      c.not_logged += static_cast<int64_t>(k - j);
+      ++c.identical;
+      j = k + 1;
     }
-    if (c.first_difference < 0 && live.size() != replayed.size()) c.first_difference = static_cast<int64_t>(n);
+    if (c.first_difference < 0) c.not_logged += static_cast<int64_t>(replayed.size() - j);
     if (c.first_difference >= 0 && static_cast<std::size_t>(c.first_difference) < live.size()) {
       const Bytes& m = live[static_cast<std::size_t>(c.first_difference)];
       c.first_difference_utime = vimot_message_utime(m.data(), static_cast<int>(m.size()));

@@ -41,10 +41,12 @@ struct ChannelComparison {
   std::string channel;
   int64_t recorded{0};
   int64_t replayed{0};
-  /// Messages equal byte for byte at the same position.
+  /// Recorded messages equal byte for byte to the replayed one in order.
   int64_t identical{0};
-  /// Position of the first difference (a differing message, or the end of
-  /// the shorter stream), -1 if the streams are equal.
+  /// Replayed messages the log lacks between (or after) identical ones: the
+  /// live process published them, the logger did not get them (UDP).
+  int64_t not_logged{0};
+  /// Index of the first recorded message not reproduced, -1 if every one was.
   int64_t first_difference{-1};
   /// utime of the recorded message there (-1 if the recording ended first).
   int64_t first_difference_utime{-1};

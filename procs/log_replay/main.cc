@@ -17,7 +17,8 @@ int run(int argc, const char* const* argv) {
                         "each config's channels) through the same Nodes as the vins / target_filter\n"
                         "processes, in log order, in one thread, as fast as the CPU allows, and compares\n"
                         "each output (VINS_STATE; NAV_STATE, TARGET_STATE, TARGET_PREDICTION) byte for byte\n"
-                        "with the messages the live processes logged. An undisturbed live run is\n"
+                        "with the messages the live processes logged, in order (a replayed message the log\n"
+                        "lacks, lost by the logger, is counted as not logged). An undisturbed live run is\n"
                         "reproduced bit for bit (docs/record_replay.md).\n"
                         "Exit status: 0 all outputs identical; 3 a difference (first one printed); 2 nothing\n"
                         "to compare (no recorded outputs); 1 bad input.");
@@ -59,12 +60,12 @@ int run(int argc, const char* const* argv) {
   if (report.cpu_s > 0) std::cout << " (" << std::setprecision(1) << report.data_span_s / report.cpu_s << "x real time)";
   std::cout << "\n";
   std::cout << std::left << std::setw(22) << "channel" << std::right << std::setw(10) << "recorded" << std::setw(10)
-            << "replayed" << std::setw(11) << "identical" << "  first difference\n";
+            << "replayed" << std::setw(11) << "identical" << std::setw(12) << "not logged" << "  first difference\n";
   int64_t recorded = 0;
   for (const vimot::ChannelComparison& c : report.channels) {
     recorded += c.recorded;
     std::cout << std::left << std::setw(22) << c.channel << std::right << std::setw(10) << c.recorded << std::setw(10)
-              << c.replayed << std::setw(11) << c.identical << "  ";
+              << c.replayed << std::setw(11) << c.identical << std::setw(12) << c.not_logged << "  ";
     if (c.equal()) {
       std::cout << "none\n";
     } else {
@@ -77,7 +78,8 @@ int run(int argc, const char* const* argv) {
     std::cerr << "vimot-log-replay: the log holds no recorded outputs to compare with\n";
     return 2;
   }
-  std::cout << (report.identical() ? "bit for bit identical to the live run\n" : "DIFFERS from the live run\n");
+  std::cout << (report.identical() ? "bit for bit identical to the live run (every logged output)\n"
+                                    : "DIFFERS from the live run\n");
   return report.identical() ? 0 : 3;
 }
 
