@@ -13,12 +13,12 @@
 #   accuracy    position RMSE (vimot-log-eval: every updated state against
 #               the ground truth; the target in the world and relative to
 #               the robot, its frame taken again at a restart) of VINS_STATE,
-#               NAV_STATE and TARGET_STATE
-#               - over the whole run, re-initialisation included, at most
-#                 10 % above the undisturbed run's;
-#               - after the restart, at most 10 % above a fresh start of the
-#                 restarted estimator at the same utime on the same data
-#                 (vimot-log-replay --from-utime on the run's log).
+#               NAV_STATE and TARGET_STATE after the restart at most 10 %
+#               above a fresh start of the restarted estimator at the same
+#               utime on the same data (vimot-log-replay --from-utime on the
+#               run's log). The whole run's RMSE against the undisturbed
+#               run's is printed, not checked: it depends on when the
+#               estimator starts again (docs/sheriff.md, "Recovery").
 # Exits 0 if every check passed, 1 if one failed, 2 on a setup error.
 #
 # Usage: scripts/kill_recovery.sh [--deputy] [--victims "vins target_filter sim"]
@@ -194,12 +194,17 @@ init_utime() {
   grep -E "^\[([^]]*:)?$2\] .*initialised from ground truth at utime [0-9]+" "$1/sheriff.txt" | tail -n 1 |
     grep -oE '[0-9]+$'
 }
-# ratio CHANNEL DIR_A DIR_B: "a m <= 1.1 x b m" check of metric CHANNEL.
+# ratio CHANNEL DIR_A DIR_B [info]: "a m <= 1.1 x b m" check of metric
+# CHANNEL; with "info" only printed.
 ratio() {
-  local a b
+  local a b text
   a=$(metric "$1" "$2"); b=$(metric "$1" "$3")
-  check "$1 position RMSE $a m <= 1.1 x $b m ($(awk -v a="$a" -v b="$b" 'BEGIN { if (b > 0) printf "%+.0f %%", 100 * (a / b - 1) }'))" \
-    le "$a" "$(awk -v b="$b" 'BEGIN { print 1.1 * b }')"
+  text="$1 position RMSE $a m against $b m ($(awk -v a="$a" -v b="$b" 'BEGIN { if (b > 0) printf "%+.0f %%", 100 * (a / b - 1) }'))"
+  if [ "${4:-}" = info ]; then
+    echo "   info  $text"
+  else
+    check "$text, at most +10 %" le "$a" "$(awk -v b="$b" 'BEGIN { print 1.1 * b }')"
+  fi
 }
 
 for victim in $victims; do
@@ -229,8 +234,10 @@ for victim in $victims; do
     r=$(grep -oE 'target restarts \(gaps above 0.5 s\): [0-9]+' "$d/target_eval.txt" | grep -oE '[0-9]+$' || true)
     check "target re-acquired (${r:-0} restart of the target in TARGET_STATE)" [ "${r:-0}" -ge 1 ]
   fi
+  # Not a check: a fresh start mid-run is a different estimator from one
+  # running since t = 0 (docs/sheriff.md, "Recovery").
   echo "   accuracy over the whole run against the undisturbed run:"
-  for ch in VINS_STATE NAV_STATE TARGET_STATE TARGET_IN_IMU; do ratio $ch "$d" "$out/undisturbed"; done
+  for ch in VINS_STATE NAV_STATE TARGET_STATE TARGET_IN_IMU; do ratio $ch "$d" "$out/undisturbed" info; done
   # After the restart against a fresh start at the same point of the same
   # data (the Nodes on this log from that utime, no network): what the
   # recovery costs beyond starting the estimator anew.
