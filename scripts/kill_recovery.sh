@@ -250,7 +250,7 @@ for victim in $victims; do
   if grep -q "bit for bit identical" "$d/fresh.txt"; then
     echo "   the restarted $restarted published exactly what a fresh start at utime $u computes (bit for bit)"
   else
-    echo "   the restarted $restarted differs from a fresh start at utime $u (input lost under load?): $d/fresh.txt"
+    echo "   the restarted $restarted differs from a fresh start at utime $u (input it lost, or a process that re-initialised without restarting): $d/fresh.txt"
   fi
   evaluate "$d/after" "$d/run.lcmlog" --from-utime "$u"
   evaluate "$d/fresh" "$d/fresh.lcmlog"
