@@ -17,6 +17,7 @@
 #include "common/eval/target_eval.h"
 #include "common/object/object_tracker.h"
 #include "common/sim/sim_config.h"
+#include "drivers/camera/camera_config.h"
 #include "drivers/imu_mip/imu_mip_config.h"
 #include "procs/feature_tracker/feature_tracker_node.h"
 #include "procs/mask_filter/mask_filter_node.h"
@@ -34,33 +35,41 @@ std::string source_path(const std::string& relative) { return std::string(VIMOT_
 // The reader of each kind of shipped config, by file name prefix.
 void load_with_its_reader(const std::string& name, const std::string& path) {
   const Config cfg = Config::load_file(path);
-  if (name == "euroc_stereo.yaml") {
+  const bool mono = name.find("mono") != std::string::npos;  // one camera
+  if (name.rfind("camera", 0) == 0) {
+    const camera::CameraConfig c = camera::camera_config_from(cfg);
+    CHECK(c.sources.size() == (mono ? 1u : 2u));
+  } else if (name == "euroc_stereo.yaml") {
     const estimator::VioOptions o = estimator::VioOptions::from_config(cfg);
     CHECK(o.cameras.size() == 2);
   } else if (name.rfind("feature_tracker", 0) == 0) {
-    const bool mono = name.find("mono") != std::string::npos;
     CHECK(FeatureTrackerNodeOptions::from_config(cfg).cameras.size() == (mono ? 1u : 2u));
   } else if (name == "imu_mip.yaml") {
     CHECK(mip::imu_mip_config_from(cfg).driver.rate_hz > 0.0);
-  } else if (name == "mask_filter.yaml") {
+  } else if (name.rfind("mask_filter", 0) == 0) {
     const MaskFilterNodeOptions o = MaskFilterNodeOptions::from_config(cfg);
-    CHECK(o.resolution.size() == 2);
+    CHECK(o.resolution.size() == (mono ? 1u : 2u));
     CHECK(o.filter.kalman.max_coast_s == 1.0);
   } else if (name == "object_tracker.yaml") {
     CHECK(object_tracker_options_from_config(cfg).window_size == 20);
   } else if (name == "scale_estimator.yaml") {
     CHECK(scale_node_options_from_config(cfg).max_pending == 60);
-  } else if (name == "segmenter.yaml") {
+  } else if (name.rfind("segmenter", 0) == 0) {
     const SegmenterNodeOptions o = SegmenterNodeOptions::from_config(cfg);
+    CHECK(o.cameras == (mono ? 1 : 2));
     CHECK(o.backend == SegmenterNodeOptions::Backend::kOnnx);
     CHECK(o.onnx.model_file == source_path("config/models/segmenter_unet.onnx"));
-  } else if (name == "target_filter.yaml") {
+  } else if (name.rfind("target_filter", 0) == 0) {
     const TargetFilterNodeOptions o = node_options_from_config(cfg);
     CHECK(o.target_enabled);
+    if (name.find("live") != std::string::npos) CHECK_FALSE(o.init_from_ground_truth);
     CHECK(o.target.sigma_t == eval::target_filter_options(cfg).sigma_t);
   } else if (name.rfind("vins", 0) == 0) {
     const VinsNodeOptions o = vins_node_options_from_config(cfg);
     CHECK(o.vio.state.max_clones == estimator::load_vio_options(path).state.max_clones);
+    CHECK(o.vio.use_stereo == !mono);
+    // A live config starts at rest: a vehicle has no ground truth.
+    if (name.find("live") != std::string::npos) CHECK_FALSE(o.init_from_ground_truth);
   } else if (name.rfind("sim_", 0) == 0) {
     if (name == "sim_trajectory.yaml" && std::getenv("VIMOT_DATA_DIR") == nullptr) {
       // Its trajectory file is in the shared data: without it, that is the error.
@@ -119,7 +128,7 @@ TEST_CASE("every shipped config loads through its reader", "[config]") {
       FAIL(e.what());
     }
   }
-  CHECK(files >= 13);
+  CHECK(files >= 20);
 }
 
 TEST_CASE("misspelt keys, unknown sections and bad values name file, key path and value", "[config]") {
@@ -156,6 +165,8 @@ TEST_CASE("misspelt keys, unknown sections and bad values name file, key path an
       {target + "\nestimator: {num_clones: 3}\n", read_target, "key 'estimator' (value '{num_clones: 3}')"},
       {"scenario: paper\ncalibration_file: euroc_stereo.yaml\ncamera: {rate_hz: 20, rate_hz: 10}\n",
        [](const Config& c) { sim::from_config(c); }, "key 'camera.rate_hz' is repeated (line 3, value '10')"},
+      {"mode: mono\nsources: {left: a.avi}\nimage: {width: 64, height: 48, fsp: 20}\n",
+       [](const Config& c) { camera::camera_config_from(c); }, "key 'image.fsp' (value '20') is unknown"},
       {"object_tracker: {window_size: 20}\nchannels: {}\nobjekt_filter: {}\n",
        [](const Config& c) { object_tracker_options_from_config(c); }, "key 'objekt_filter' (value '{}')"},
   };

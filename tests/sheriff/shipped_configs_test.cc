@@ -1,9 +1,15 @@
 // The shipped sheriff configs (sheriff_configs/*.pmd) load without warnings,
-// start the processes their scenario needs and name config files that exist.
+// start the processes their scenario needs, name config files that exist and
+// only vimot executables that the build makes.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -15,9 +21,16 @@ namespace {
 
 std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
 
+// The configs the test cases below check; a .pmd in the folder but not
+// here fails.
+const std::set<std::string> kChecked = {"sim_demo.pmd",    "sim_mono.pmd",      "euroc.pmd",
+                                        "sim_pixels.pmd",  "two_hosts.pmd",     "live_stereo.pmd",
+                                        "live_mono.pmd",   "log_playback.pmd",  "two_hosts_live.pmd"};
+
 void check_config(const std::string& pmd, const std::vector<std::string>& expected_commands,
                   const std::vector<std::string>& config_files) {
   INFO(pmd);
+  CHECK(kChecked.count(pmd) == 1);
   const SheriffConfig config = LoadSheriffConfig(source_path("sheriff_configs/" + pmd));
   CHECK(config.warnings().empty());
   std::vector<std::string> names;
@@ -47,6 +60,18 @@ TEST_CASE("shipped sheriff configs parse") {
                {"vins_euroc.yaml", "feature_tracker.yaml"});
   check_config("sim_pixels.pmd", {"logger", "vins", "target_filter", "feature_tracker", "sim"},
                {"target_filter.yaml"});
+  // Onboard the target filter is the VIO: no vins beside it.
+  check_config("live_stereo.pmd",
+               {"logger", "target_filter", "feature_tracker", "segmenter", "mask_filter", "imu", "camera"},
+               {"target_filter_live.yaml", "feature_tracker_live.yaml", "segmenter.yaml", "mask_filter.yaml",
+                "imu_mip.yaml", "camera.yaml"});
+  check_config("live_mono.pmd",
+               {"logger", "vins", "object_tracker", "scale_estimator", "feature_tracker", "segmenter", "mask_filter",
+                "imu", "camera"},
+               {"vins_live_mono.yaml", "object_tracker.yaml", "scale_estimator.yaml", "feature_tracker_live_mono.yaml",
+                "segmenter_mono.yaml", "mask_filter_mono.yaml", "imu_mip.yaml", "camera_mono.yaml"});
+  // The estimator configs come from the environment (simulated or real log).
+  check_config("log_playback.pmd", {"logger", "vins", "target_filter", "player"}, {});
 }
 
 TEST_CASE("the two-host layout puts each command on its machine") {
@@ -58,4 +83,38 @@ TEST_CASE("the two-host layout puts each command on its machine") {
   CHECK(host["vins"] == "vehicle");
   CHECK(host["target_filter"] == "vehicle");
   CHECK(host["sim"] == "vehicle");
+}
+
+TEST_CASE("the live two-host layout: sensors and estimators on the vehicle, a logger on each host") {
+  check_config("two_hosts_live.pmd",
+               {"vehicle_logger", "ground_logger", "target_filter", "feature_tracker", "segmenter", "mask_filter", "imu",
+                "camera"},
+               {"target_filter_live.yaml", "feature_tracker_live.yaml", "segmenter.yaml", "mask_filter.yaml",
+                "imu_mip.yaml", "camera.yaml"});
+  const SheriffConfig config = LoadSheriffConfig(source_path("sheriff_configs/two_hosts_live.pmd"));
+  for (const CommandSpec& c : config.commands()) {
+    INFO(c.name);
+    CHECK(c.host == (c.name == "ground_logger" ? "ground" : "vehicle"));
+  }
+}
+
+TEST_CASE("every shipped config is checked and names only executables the build makes") {
+  int executables = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(source_path("sheriff_configs"))) {
+    if (entry.path().extension() != ".pmd") continue;
+    const std::string pmd = entry.path().filename().string();
+    INFO(pmd);
+    CHECK(kChecked.count(pmd) == 1);
+    const SheriffConfig config = LoadSheriffConfig(entry.path().string());
+    const std::regex vimot_exec(R"(\$\{VIMOT_BIN\}/(\S+))");
+    for (const CommandSpec& c : config.commands()) {
+      for (std::sregex_iterator m(c.exec.begin(), c.exec.end(), vimot_exec), end; m != end; ++m) {
+        const std::string path = std::string(VIMOT_BIN_DIR) + "/" + (*m)[1].str();
+        INFO(c.name << ": " << path);
+        CHECK(::access(path.c_str(), X_OK) == 0);
+        ++executables;
+      }
+    }
+  }
+  CHECK(executables >= 30);
 }
