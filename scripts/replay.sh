@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Plays a recorded vimot log back, right.
 #
-# Usage: scripts/replay.sh LOG [--speed S] [--all | --sensors | -e REGEX] [--url URL]
+# Usage: scripts/replay.sh LOG [--speed S] [--all | --sensors | -e REGEX] [--url URL] [--stack]
 #        scripts/replay.sh LOG --offline
 #   --speed S   real-time factor of the data (default 1: as fast as the
 #               sensors produced it). The log may have been recorded at
@@ -19,6 +19,13 @@
 #     --all       everything in the log (to watch a run in lcm-spy)
 #     -e REGEX    lcm-logplayer's channel regular expression
 #   --url URL   LCM network (default $LCM_DEFAULT_URL, else LCM's)
+#   --stack     play into a fresh vins and target filter under vimot-sheriff
+#               (sheriff_configs/log_playback.pmd: logger, vins,
+#               target_filter, the player) and record their new run in
+#               $VIMOT_OUT/replay.lcmlog (default out/replay-<date>/);
+#               configs VIMOT_VINS_CONFIG (vins.yaml) and VIMOT_TARGET_CONFIG
+#               (target_filter.yaml; for a real log vins_euroc.yaml and
+#               target_filter_live.yaml)
 #   --offline   no network: replay the log deterministically through the
 #               vins / target_filter Nodes (vimot-log-replay, configs
 #               config/$VIMOT_VINS_CONFIG and config/target_filter.yaml) and
@@ -37,6 +44,7 @@ speed=1
 regex='^(IMU|FEATURES|GROUND_TRUTH)$'
 url="${LCM_DEFAULT_URL:-}"
 offline=0
+stack=0
 while [ $# -gt 0 ]; do
   case "$1" in
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
@@ -46,6 +54,7 @@ while [ $# -gt 0 ]; do
     -e) regex="${2:?replay.sh: -e needs a regular expression}"; shift 2 ;;
     --url) url="${2:?replay.sh: --url needs a URL}"; shift 2 ;;
     --offline) offline=1; shift ;;
+    --stack) stack=1; shift ;;
     -*) echo "replay.sh: unknown option '$1' (see --help)" >&2; exit 1 ;;
     *) [ -z "$log" ] || { echo "replay.sh: one log only ('$log', '$1')" >&2; exit 1; }; log="$1"; shift ;;
   esac
@@ -79,7 +88,27 @@ else
   echo "replay.sh: the recorded speed of $log is unknown (no sensor channel spans any time); playing at -s $speed" >&2
   factor="$speed"
 fi
+echo "replay.sh: $log was recorded at ${recorded}x; playing channels $regex at ${speed}x (lcm-logplayer -s $factor)" >&2
+if [ $stack -eq 1 ]; then
+  out="${VIMOT_OUT:-$here/out/replay-$(date +%Y%m%d-%H%M%S)}"
+  mkdir -p "$out"
+  [ -n "$url" ] && export LCM_DEFAULT_URL="$url"
+  export VIMOT_BIN="$bin" VIMOT_CONFIG="${VIMOT_CONFIG:-$here/config}" VIMOT_LOG="$out/replay.lcmlog"
+  export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins.yaml}" VIMOT_TARGET_CONFIG="${VIMOT_TARGET_CONFIG:-target_filter.yaml}"
+  export VIMOT_REPLAY_LOG="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
+  export VIMOT_REPLAY_CHANNELS="$regex" VIMOT_REPLAY_SPEED="$factor"
+  echo "replay.sh: running sheriff_configs/log_playback.pmd (output in $out/sheriff.txt)" >&2
+  status=0
+  "$bin/vimot-sheriff" --script run --exit-when player "$here/sheriff_configs/log_playback.pmd" \
+    > "$out/sheriff.txt" 2>&1 || status=$?
+  if [ $status -ne 0 ]; then
+    echo "replay.sh: the sheriff exited with status $status; last lines of $out/sheriff.txt:" >&2
+    tail -n 20 "$out/sheriff.txt" >&2
+    exit $status
+  fi
+  "$bin/vimot-log-summary" "$VIMOT_LOG"
+  exit 0
+fi
 args=(-s "$factor" -e "$regex")
 [ -n "$url" ] && args+=("--lcm-url=$url")
-echo "replay.sh: $log was recorded at ${recorded}x; playing channels $regex at ${speed}x (lcm-logplayer -s $factor)" >&2
 exec lcm-logplayer "${args[@]}" "$log"
