@@ -214,7 +214,7 @@ if [ $pipeline = mono ]; then
     | grep -E '^(scale|metric|filtered|compare|  (scale|accepted|last|object|filtered))' | sed 's/^/   /'
   echo "   (offline run: $out/offline_scale.txt)"
   echo "== log: $VIMOT_LOG"
-  echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
+  echo "   replay: scripts/replay.sh $VIMOT_LOG [--offline]    watch: scripts/lcm-spy.sh"
   finish
 fi
 echo "== robot accuracy of the target filter (NAV_STATE, Schmidt-EKF: must equal VINS_STATE):"
@@ -256,5 +256,5 @@ if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ]; then
   finish
 fi
 echo "== log: $VIMOT_LOG"
-echo "   replay: lcm-logplayer $VIMOT_LOG    watch: scripts/lcm-spy.sh"
+echo "   replay: scripts/replay.sh $VIMOT_LOG [--offline]    watch: scripts/lcm-spy.sh"
 finish

@@ -8,6 +8,7 @@
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/process/log_reader.h"
+#include "common/time/utime.h"
 
 namespace vimot {
 namespace eval {
@@ -41,6 +42,7 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   log.on_nav_state(
       options.state_channel,
       [&](const NavState& x) {
+        if (x.utime < options.from_utime) return;
         matcher.add_state(x);
         if (x.updated) state_utimes.push_back(x.utime);
       },
@@ -48,6 +50,7 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   log.on_target_state(
       options.target_channel,
       [&](const TargetStateEstimate& x) {
+        if (x.utime < options.from_utime) return;
         matcher.add_target(x);
         target_utimes.insert(x.utime);
       },
@@ -80,7 +83,8 @@ LogEvalResult evaluate_log(const std::string& path, const LogEvalOptions& option
   for (const ErrorSample& s : r.samples) errors.add(s);
   r.summary = errors.summary();
   if (!options.target_channel.empty()) {
-    r.target_samples = matcher.match_targets(&r.target_counts, options.target_own_frame);
+    r.target_samples = matcher.match_targets(&r.target_counts, options.target_own_frame,
+                                            seconds_to_utime(options.target_restart_gap_s));
     TrajectoryErrors in_imu, in_world;
     for (const ErrorSample& s : r.target_samples.target_in_imu) in_imu.add(s);
     for (const ErrorSample& s : r.target_samples.target_in_world) in_world.add(s);

@@ -25,6 +25,13 @@ struct LogEvalOptions {
   /// The target filter started from its features (its own target frame):
   /// compare through the fixed transform at its first state (TruthMatcher).
   bool target_own_frame{false};
+  /// With target_own_frame: target states further apart than this (s) are a
+  /// restart of the target in a new frame (TruthMatcher::match_targets);
+  /// 0: the frame is taken once.
+  double target_restart_gap_s{0.0};
+  /// Only states and target states at or after this utime are evaluated
+  /// (e.g. what a restarted process published); 0: all.
+  int64_t from_utime{0};
   // Monocular scale pipeline: scale_estimate_t and metric_object_pose_t
   // against the truth of the tracker's tracks (from vimot-scale-eval's
   // summary.json of the same seed: the object frame O is defined by the

@@ -65,16 +65,26 @@ ErrorSample error_without_covariance(int64_t utime, const Eigen::Vector4d& q_tru
 
 }  // namespace
 
-TargetMatch TruthMatcher::match_targets(TargetMatchCounts* counts, bool own_frame) const {
+TargetMatch TruthMatcher::match_targets(TargetMatchCounts* counts, bool own_frame, int64_t restart_gap_us) const {
   TargetMatchCounts c = target_counts_;
   TargetMatch out;
+  bool take_frame = own_frame;
+  int64_t previous_utime = -1;
   for (const auto& [utime, est] : targets_) {
+    if (own_frame && restart_gap_us > 0 && previous_utime >= 0 && utime - previous_utime > restart_gap_us) {
+      take_frame = true;
+      ++out.frame_restarts;
+    }
+    previous_utime = utime;
     const auto it = truths_.find(utime);
     if (it == truths_.end() || !it->second.has_target) {
       ++c.unmatched;
       continue;
     }
-    if (own_frame && c.matched == 0) out.target_frame = target_frame_transform(it->second, est.q_ItoT, est.p_TinI);
+    if (take_frame) {
+      out.target_frame = target_frame_transform(it->second, est.q_ItoT, est.p_TinI);
+      take_frame = false;
+    }
     ++c.matched;
     const GroundTruth t = in_target_frame(it->second, out.target_frame);
     const TargetInImu truth_in_imu = true_target_in_imu(t);

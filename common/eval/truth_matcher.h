@@ -44,8 +44,11 @@ struct TargetMatchCounts {
 struct TargetMatch {
   std::vector<ErrorSample> target_in_imu;    // [q_ItoT, p_TinI]
   std::vector<ErrorSample> target_in_world;  // [q_GtoT, p_TinG]
-  /// The filter's target frame in the true one (identity unless own_frame).
+  /// The filter's target frame in the true one (identity unless own_frame;
+  /// the last one taken).
   TargetFrameTransform target_frame;
+  /// Times the frame was taken again after a restart gap.
+  int64_t frame_restarts{0};
 };
 
 class TruthMatcher {
@@ -58,8 +61,11 @@ class TruthMatcher {
   std::vector<ErrorSample> match(MatchCounts* counts) const;
   /// own_frame: the filter defined its own target frame (init mode
   /// features); the truth is taken in it, through the fixed transform at the
-  /// first matched target state (target_frame.h).
-  TargetMatch match_targets(TargetMatchCounts* counts, bool own_frame = false) const;
+  /// first matched target state (target_frame.h). restart_gap_us > 0 (with
+  /// own_frame): target states more than this apart mean the filter started
+  /// its target again (a respawned process, a reset), in a new frame of its
+  /// own, which is taken at the first matched state after the gap.
+  TargetMatch match_targets(TargetMatchCounts* counts, bool own_frame = false, int64_t restart_gap_us = 0) const;
 
  private:
   std::map<int64_t, NavState> states_;  // updated states by utime

@@ -1,6 +1,7 @@
 #include "common/process/event_sink.h"
 
 #include <algorithm>
+#include <fstream>
 #include <thread>
 
 #include "common/time/utime.h"
@@ -56,12 +57,42 @@ void add_sink_options(ArgParser& args) {
                   "0");
 }
 
-std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime) {
+void add_clock_file_option(ArgParser& args) {
+  args.add_option("clock-file", "FILE",
+                  "keep the run's schedule across restarts of this driver: a restart within the run skips\n"
+                  "what fell due while it was down, as a real sensor (the file holds the wall-clock time the\n"
+                  "run's first message was due; a fresh run writes it)");
+}
+
+std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime, double span_s, int64_t* resume) {
   const ArgParser& args = process.args();
   const double speed = args.get_double("speed");
   if (speed < 0.0) throw ArgError(process.name() + ": --speed must be >= 0, got " + args.get("speed"));
+  if (resume != nullptr) *resume = first_utime;
+  const bool clock_file = resume != nullptr && args.given("clock-file");
+  if (clock_file && (args.given("log") || speed == 0.0)) {
+    throw ArgError(process.name() + ": --clock-file needs a paced run (--speed > 0, no --log)");
+  }
   if (args.given("log")) return std::make_unique<LogFileSink>(args.get("log"));
-  return std::make_unique<LcmSink>(process, speed, first_utime, args.get_double("start-delay"));
+  double start_delay_s = args.get_double("start-delay");
+  if (clock_file) {
+    const std::string path = args.get("clock-file");
+    const int64_t now = wall_clock_utime();
+    int64_t first_due = -1;
+    std::ifstream(path) >> first_due;
+    const double since_first_s = utime_to_seconds(now - first_due);
+    if (first_due > 0 && since_first_s >= 0.0 && since_first_s < span_s / speed) {
+      *resume = first_utime + seconds_to_utime(since_first_s * speed);
+      start_delay_s = -since_first_s;  // the first start's schedule
+      log_info("restarted ", since_first_s, " s into the run of ", path, ": going on from ",
+               utime_to_seconds(*resume - first_utime), " s of data");
+    } else {
+      std::ofstream out(path, std::ios::trunc);
+      out << now + seconds_to_utime(start_delay_s) << "\n";
+      if (!out.good()) throw std::runtime_error(process.name() + ": cannot write --clock-file '" + path + "'");
+    }
+  }
+  return std::make_unique<LcmSink>(process, speed, first_utime, start_delay_s);
 }
 
 void ProgressLog::update(double played_s) {

@@ -55,10 +55,25 @@ class LcmSink : public EventSink {
 /// --log, --linger.
 void add_sink_options(ArgParser& args);
 
+/// Declares --clock-file FILE: a paced run whose driver may be restarted
+/// mid-run (a sheriff's auto_respawn) goes on as a real sensor would.
+void add_clock_file_option(ArgParser& args);
+
 /// The sink those options ask for: the --log file if given, else LCM paced
 /// by --speed with `first_utime` leaving after --start-delay. Throws
 /// ArgError for a negative --speed.
-std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime);
+///
+/// `resume`, for a driver that declared --clock-file, receives the utime of
+/// the first message to send: `first_utime`, or with --clock-file on a
+/// restart within the run (the file holds the wall-clock time the run's
+/// first message was due, and the run of `span_s` at --speed has not ended)
+/// the utime due now: what fell due while the driver was down is skipped
+/// and the rest keeps the first start's schedule. A fresh run (no file, or
+/// the file's run has ended) writes the file. Throws ArgError if
+/// --clock-file comes with --log or --speed 0, std::runtime_error if the
+/// file cannot be written.
+std::unique_ptr<EventSink> make_sink(Process& process, int64_t first_utime, double span_s = 0.0,
+                                     int64_t* resume = nullptr);
 
 /// Logs "progress N% (t s)" each time another tenth of a run is played.
 class ProgressLog {

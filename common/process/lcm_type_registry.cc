@@ -32,8 +32,8 @@ LcmTypeInfo info(const LcmStruct& layout) {
                      }};
 }
 
-int64_t read_fingerprint(const void* data) {
-  // LCM writes the fingerprint big-endian.
+// LCM writes integers (the fingerprint, utime) big-endian.
+int64_t read_be_int64(const void* data) {
   const auto* b = static_cast<const uint8_t*>(data);
   uint64_t v = 0;
   for (int i = 0; i < 8; ++i) v = (v << 8) | b[i];
@@ -192,9 +192,14 @@ const std::vector<LcmTypeInfo>& vimot_lcm_types() {
   return types;
 }
 
+int64_t vimot_message_utime(const void* data, int size) {
+  if (size < 16) return -1;
+  return read_be_int64(static_cast<const uint8_t*>(data) + 8);
+}
+
 const LcmTypeInfo* find_lcm_type(const void* data, int size) {
   if (size < 8) return nullptr;
-  const int64_t fp = read_fingerprint(data);
+  const int64_t fp = read_be_int64(data);
   for (const LcmTypeInfo& t : vimot_lcm_types()) {
     if (t.fingerprint == fp) return &t;
   }

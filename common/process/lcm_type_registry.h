@@ -29,6 +29,10 @@ const std::vector<LcmTypeInfo>& vimot_lcm_types();
 /// or fewer than 8 bytes).
 const LcmTypeInfo* find_lcm_type(const void* data, int size);
 
+/// The utime of an encoded vimot message (every vimot type starts with it,
+/// right after the fingerprint); -1 if `size` < 16.
+int64_t vimot_message_utime(const void* data, int size);
+
 /// The layout of the vimot type with this fingerprint; throws
 /// std::logic_error naming `type_name` if it is not a registered vimot type.
 const LcmStruct& vimot_lcm_layout(int64_t fingerprint, const std::string& type_name);

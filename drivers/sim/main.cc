@@ -41,6 +41,7 @@ int run(int argc, const char* const* argv) {
   process.args().add_option("seed", "N", "noise seed (overrides the config's seed)");
   process.args().add_option("duration", "SECONDS", "simulate only this long (overrides the config)");
   vimot::add_sink_options(process.args());
+  vimot::add_clock_file_option(process.args());
   process.args().add_flag("render", "publish rendered images, target masks and boxes instead of FEATURES");
   process.args().add_flag("with-features", "with --render, publish FEATURES too");
   if (!process.init(argc, argv)) return 0;
@@ -65,7 +66,9 @@ int run(int argc, const char* const* argv) {
   std::unique_ptr<vimot::sim::Renderer> renderer;
   if (render) renderer = std::make_unique<vimot::sim::Renderer>(sim);
 
-  const std::unique_ptr<vimot::EventSink> sink = vimot::make_sink(process, sim.start_utime());
+  int64_t resume_utime = sim.start_utime();
+  const std::unique_ptr<vimot::EventSink> sink =
+      vimot::make_sink(process, sim.start_utime(), sim.duration(), &resume_utime);
   log_info("scenario ", vimot::sim::to_string(config.scenario), ", seed ", config.seed, ", ", sim.duration(),
            " s, path ", sim.path_length(), " m, ", sim.imu_sample_count(), " IMU samples, ",
            sim.camera_frame_count(), " camera frames",
@@ -76,6 +79,8 @@ int run(int argc, const char* const* argv) {
   while (!process.stop_requested()) {
     const std::optional<vimot::sim::SimEvent> event = sim.next();
     if (!event) break;
+    // Restarted mid-run (--clock-file): what fell due meanwhile was never sent.
+    if (std::visit([](const auto& e) { return e.utime; }, *event) < resume_utime) continue;
     int64_t utime = 0;
     if (const auto* imu = std::get_if<vimot::ImuData>(&*event)) {
       vimot::emit(*sink, imu_channel, vimot::to_lcm(*imu));

@@ -41,6 +41,13 @@ int run(int argc, const char* const* argv) {
                 "with --target-channel: the filter started its target from its features (target.init.mode\n"
                 "features), so its target frame is its own: compare through the fixed transform to the true\n"
                 "frame taken at its first target state (printed)");
+  args.add_option("target-restart-gap", "SECONDS",
+                  "with --own-target-frame: target states more than SECONDS apart mean the filter started its\n"
+                  "target again (a respawned process, a reset) in a new frame of its own, taken again at its\n"
+                  "first state after the gap (default: taken once)");
+  args.add_option("from-utime", "UTIME",
+                  "evaluate only the states (and target states) at or after this utime, e.g. those of a\n"
+                  "process restarted mid-run (its \"initialised from ground truth at utime N\")");
   args.add_option("compare-target", "SUMMARY_JSON",
                   "with --target-channel: print the relative difference of the target figures to a\n"
                   "one-run vimot-target-eval summary.json (its first target-filter cell)");
@@ -69,6 +76,15 @@ int run(int argc, const char* const* argv) {
   opt.truth_channel = args.get("truth-channel");
   opt.target_channel = args.get("target-channel");
   opt.target_own_frame = args.given("own-target-frame");
+  if (args.given("target-restart-gap")) {
+    if (!opt.target_own_frame) throw ArgError("vimot-log-eval: --target-restart-gap needs --own-target-frame");
+    opt.target_restart_gap_s = args.get_double("target-restart-gap");
+    if (!(opt.target_restart_gap_s > 0.0)) throw ArgError("vimot-log-eval: --target-restart-gap must be > 0");
+  }
+  if (args.given("from-utime")) {
+    opt.from_utime = args.get_int("from-utime");
+    if (opt.from_utime < 0) throw ArgError("vimot-log-eval: --from-utime must be >= 0");
+  }
   if (args.given("scale-truth")) {
     opt.scale_channel = args.get("scale-channel");
     opt.metric_channel = args.get("metric-channel");
@@ -133,6 +149,10 @@ int run(int argc, const char* const* argv) {
     if (opt.target_own_frame) {
       std::printf("target frame (filter's in the true one, fixed at its first state): %s\n",
                   r.target_samples.target_frame.describe().c_str());
+      if (opt.target_restart_gap_s > 0.0) {
+        std::printf("target restarts (gaps above %.3g s): %lld, the frame taken again at each\n",
+                    opt.target_restart_gap_s, static_cast<long long>(r.target_samples.frame_restarts));
+      }
     }
     for (const auto& [name, ts] : {std::pair<const char*, const eval::ErrorSummary&>{"in IMU  ", r.target_in_imu},
                                    std::pair<const char*, const eval::ErrorSummary&>{"in world", r.target_in_world}}) {

@@ -16,4 +16,6 @@ cat "$work/summary.txt"
 grep -Eq '^IMU +vimot.imu_t +2001 ' "$work/summary.txt" || { echo "FAIL: expected 2001 IMU messages"; exit 1; }
 grep -Eq '^GROUND_TRUTH +vimot.ground_truth_t +2001 ' "$work/summary.txt" || { echo "FAIL: expected 2001 GROUND_TRUTH"; exit 1; }
 grep -Eq '^FEATURES +vimot.features_t +101 ' "$work/summary.txt" || { echo "FAIL: expected 101 FEATURES"; exit 1; }
+# Event time = utime: a log "recorded at" real time, which scripts/replay.sh relies on.
+[ "$("$summary" --speed "$work/a.lcm")" = 1 ] || { echo "FAIL: vimot-sim --log must read as recorded at 1x"; exit 1; }
 echo "PASS"

@@ -7,6 +7,7 @@
 
 #include "common/eval/metrics.h"
 #include "common/eval/target_frame.h"
+#include "common/eval/truth_matcher.h"
 #include "common/math/quat.h"
 
 using namespace vimot;
@@ -82,4 +83,46 @@ TEST_CASE("target frame transform: identity leaves the truth untouched", "[eval]
   const TargetFrameTransform Y = target_frame_transform(t, ti.q_ItoT, ti.p_TinI);
   CHECK(Y.angle_deg() < 1e-9);
   CHECK(Y.p_TestInT.norm() < 1e-12);
+}
+
+// A target filter that restarts (a respawned process) defines a new frame of
+// its own: with a restart gap the matcher takes the frame again after it.
+TEST_CASE("target restarts: the frame is taken again after a gap in the target states", "[eval][target]") {
+  // The filter's estimate of frame T ∘ X is exact: the truth seen in that frame.
+  const auto estimate = [](double t, const TargetFrameTransform& X) {
+    const GroundTruth g = in_target_frame(truth_at(t), X);
+    const TargetInImu ti = true_target_in_imu(g);
+    TargetStateEstimate e;
+    e.utime = g.utime;
+    e.q_ItoT = ti.q_ItoT;
+    e.p_TinI = ti.p_TinI;
+    e.q_GtoT = g.q_GtoT;
+    e.p_TinG = g.p_TinG;
+    e.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
+    return e;
+  };
+  TargetFrameTransform first, second;
+  first.q_TtoTest = rot_to_quat(exp_so3(Eigen::Vector3d(0.0, 0.0, 0.7)));
+  first.p_TestInT = Eigen::Vector3d(0.2, -0.1, 0.3);
+  second.q_TtoTest = rot_to_quat(exp_so3(Eigen::Vector3d(0.0, 0.0, -1.1)));
+  second.p_TestInT = Eigen::Vector3d(-0.3, 0.4, 0.0);
+  TruthMatcher matcher;
+  for (int k = 0; k <= 40; ++k) matcher.add_truth(truth_at(0.1 * k));
+  for (int k = 0; k <= 10; ++k) matcher.add_target(estimate(0.1 * k, first));   // 0 .. 1 s
+  for (int k = 25; k <= 40; ++k) matcher.add_target(estimate(0.1 * k, second)); // after a 1.5 s gap
+
+  TargetMatchCounts counts;
+  const TargetMatch again = matcher.match_targets(&counts, /*own_frame=*/true, /*restart_gap_us=*/500000);
+  REQUIRE(counts.matched == 27);
+  CHECK(again.frame_restarts == 1);
+  CHECK(orientation_error(again.target_frame.q_TtoTest, second.q_TtoTest).norm() < 1e-9);
+  for (const ErrorSample& e : again.target_in_world) {
+    CHECK(e.err_p.norm() < 1e-9);
+    CHECK(e.err_theta.norm() < 1e-9);
+  }
+  // Taken once, the second run's states are compared in the wrong frame.
+  const TargetMatch once = matcher.match_targets(&counts, /*own_frame=*/true);
+  CHECK(once.frame_restarts == 0);
+  CHECK(once.target_in_world.front().err_p.norm() < 1e-9);
+  CHECK(once.target_in_world.back().err_p.norm() > 0.1);
 }

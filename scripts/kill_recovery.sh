@@ -1,0 +1,268 @@
+#!/usr/bin/env bash
+# Kill-and-recover check of the simulated stereo stack
+# (sheriff_configs/sim_demo.pmd: logger, vins, target_filter, sim; all but
+# the logger with auto_respawn). Runs the stack once undisturbed, then once
+# per victim, killing the victim with SIGKILL mid-run, and checks:
+#   respawned   the sheriff (or deputy) started it again;
+#   back        its outputs (vins: VINS_STATE; target_filter: NAV_STATE and
+#               TARGET_STATE, i.e. the target re-acquired; sim: IMU and every
+#               estimate) fell silent for at most 3 s in the log
+#               (lcm-logger's wall clock);
+#   others      no other command exited, and the other estimator's outputs
+#               never fell silent for more than 1 s;
+#   accuracy    position RMSE (vimot-log-eval: every updated state against
+#               the ground truth; the target in the world and relative to
+#               the robot, its frame taken again at a restart) of VINS_STATE,
+#               NAV_STATE and TARGET_STATE after the restart at most 10 %
+#               above a fresh start of the restarted estimator at the same
+#               utime on the same data (vimot-log-replay --from-utime on the
+#               run's log). The whole run's RMSE against the undisturbed
+#               run's is printed, not checked: it depends on when the
+#               estimator starts again (docs/sheriff.md, "Recovery").
+# Exits 0 if every check passed, 1 if one failed, 2 on a setup error.
+#
+# Usage: scripts/kill_recovery.sh [--deputy] [--victims "vins target_filter sim"]
+#                                 [--kill-at SECONDS]
+#   --deputy     run the commands through a vimot-deputy driven by
+#                vimot-sheriff --lcm (procman's protocol) instead of locally
+#   --victims    processes to kill, one run each (default: all three)
+#   --kill-at S  wall-clock seconds after the simulator started (default 20)
+# Environment: VIMOT_SPEED (default 1; a real-time run: not niced), VIMOT_SEED
+# (1), VIMOT_SIM_CONFIG (sim_paper.yaml), VIMOT_OUT (out/kill-recovery-<date>),
+# LCM_DEFAULT_URL (default a private group, port 7698, ttl=0).
+# Details and measured figures: docs/sheriff.md ("Recovery").
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bin="${VIMOT_BUILD_DIR:-$here/build}/bin"
+
+mode=local
+victims="vins target_filter sim"
+kill_at=20
+while [ $# -gt 0 ]; do
+  case "$1" in
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+    --deputy) mode=deputy; shift ;;
+    --victims) victims="${2:?kill_recovery.sh: --victims needs names}"; shift 2 ;;
+    --kill-at) kill_at="${2:?kill_recovery.sh: --kill-at needs seconds}"; shift 2 ;;
+    *) echo "kill_recovery.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[[ "$kill_at" =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "kill_recovery.sh: --kill-at must be seconds" >&2; exit 2; }
+for v in $victims; do
+  case "$v" in
+    vins|target_filter|sim) ;;
+    *) echo "kill_recovery.sh: cannot check '$v' (vins, target_filter or sim; see docs/sheriff.md)" >&2; exit 2 ;;
+  esac
+done
+for exe in vimot-sheriff vimot-deputy vimot-sim vimot-vins vimot-target-filter vimot-log-summary vimot-log-eval \
+           vimot-log-replay; do
+  [ -x "$bin/$exe" ] || { echo "kill_recovery.sh: $bin/$exe not built (scripts/build.sh)" >&2; exit 2; }
+done
+
+export VIMOT_BIN="$bin" VIMOT_CONFIG="$here/config"
+export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}" VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins.yaml}"
+export VIMOT_SPEED="${VIMOT_SPEED:-1}" VIMOT_SEED="${VIMOT_SEED:-1}"
+export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7698?ttl=0&recv_buf_size=4194304}"
+pmd="$here/sheriff_configs/sim_demo.pmd"
+out="${VIMOT_OUT:-$here/out/kill-recovery-$(date +%Y%m%d-%H%M%S)}"
+mkdir -p "$out"
+host="kill-recovery-$$"
+# A safety cap only: a run ends when the simulator does.
+cap=900
+
+pids=()
+cleanup() {
+  local p
+  for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+
+# The first pid the sheriff output gives for command $2 after line $3 (0: none).
+pid_of() {
+  local file="$1" cmd="$2"
+  if [ $mode = local ]; then
+    grep -oE "(started|respawned) '$cmd' \(pid [0-9]+\)" "$file" | tail -n 1 | grep -oE '[0-9]+\)$' | tr -d ')'
+  else
+    grep -oE "\] $host:$cmd running \(pid [0-9]+\)" "$file" | tail -n 1 | grep -oE '[0-9]+\)$' | tr -d ')'
+  fi
+}
+sim_started() {
+  if [ $mode = local ]; then grep -q "started 'sim'" "$1"; else grep -q "\] $host:sim running" "$1"; fi
+}
+# Through a deputy (no --exit-when in --lcm mode): the simulator has sent its
+# last message (it lingers 2 s for the consumers, then exits, and would be
+# respawned: the script stops the sheriff before that).
+sim_done() { grep -qE "^\[$host:sim\] .*done: " "$1"; }
+
+# run NAME [VICTIM]: one run of the stack; kills VICTIM kill_at s after the simulator started.
+run() {
+  local name="$1" victim="${2:-}" dir="$out/$1"
+  mkdir -p "$dir"
+  export VIMOT_LOG="$dir/run.lcmlog"
+  local sheriff deputy=""
+  : > "$dir/sheriff.txt"
+  if [ $mode = local ]; then
+    "$bin/vimot-sheriff" --script run --exit-when sim --duration "$cap" "$pmd" > "$dir/sheriff.txt" 2>&1 &
+    sheriff=$!
+  else
+    "$bin/vimot-deputy" --name "$host" > "$dir/deputy.txt" 2>&1 &
+    deputy=$!
+    pids+=("$deputy")
+    sleep 1
+    "$bin/vimot-sheriff" --lcm --local-host "$host" --script run --duration "$cap" "$pmd" > "$dir/sheriff.txt" 2>&1 &
+    sheriff=$!
+  fi
+  pids+=("$sheriff")
+  local t=0
+  until sim_started "$dir/sheriff.txt"; do
+    sleep 0.1; t=$((t + 1))
+    [ $t -lt 300 ] || { echo "$name: the simulator did not start; see $dir/sheriff.txt" >&2; return 1; }
+  done
+  if [ -n "$victim" ]; then
+    sleep "$kill_at"
+    local pid
+    pid=$(pid_of "$dir/sheriff.txt" "$victim")
+    [ -n "$pid" ] || { echo "$name: no pid for $victim in $dir/sheriff.txt" >&2; return 1; }
+    kill -9 "$pid"
+    echo "$pid $(date +%s%6N)" > "$dir/killed"
+    echo "   killed $victim (pid $pid) with SIGKILL"
+  fi
+  if [ $mode = deputy ]; then
+    until sim_done "$dir/sheriff.txt" || ! kill -0 "$sheriff" 2>/dev/null; do sleep 0.2; done
+    sleep 1.5
+    kill -INT "$sheriff" 2>/dev/null || true
+  fi
+  # Locally --exit-when sim ends the run.
+  wait "$sheriff" || true
+  if [ -n "$deputy" ]; then kill -INT "$deputy" 2>/dev/null || true; wait "$deputy" || true; fi
+  pids=()
+  "$bin/vimot-log-summary" --gaps "$VIMOT_LOG" > "$dir/summary.txt" || true
+  evaluate "$dir" "$VIMOT_LOG"
+}
+
+# evaluate DIR LOG [EVAL OPTIONS...]: vimot-log-eval of VINS_STATE and of NAV_STATE + TARGET_STATE.
+evaluate() {
+  local dir="$1" log="$2"
+  shift 2
+  mkdir -p "$dir"
+  "$bin/vimot-log-eval" "$log" "$@" > "$dir/vins_eval.txt" 2>&1 || true
+  "$bin/vimot-log-eval" "$log" "$@" --state-channel NAV_STATE --target-channel TARGET_STATE --own-target-frame \
+    --target-restart-gap 0.5 > "$dir/target_eval.txt" 2>&1 || true
+}
+
+gap() { awk -v c="$2" '$1 == c { print $7 }' "$1/summary.txt"; }
+rmse_vio() { awk '$1 == "samples" { print $5 }' "$1/$2"; }
+rmse_target() { awk -v w="$2" '$0 ~ "^target in " w { for (i = 1; i <= NF; ++i) if ($i == "RMSE") { print $(i + 1); exit } }' "$1/target_eval.txt"; }
+metric() {  # metric NAME DIR
+  case "$1" in
+    VINS_STATE) rmse_vio "$2" vins_eval.txt ;;
+    NAV_STATE) rmse_vio "$2" target_eval.txt ;;
+    TARGET_STATE) rmse_target "$2" world ;;
+    TARGET_IN_IMU) rmse_target "$2" IMU ;;
+  esac
+}
+
+failures=0
+check() {  # check TEXT COMMAND...: ok if COMMAND succeeds
+  local text="$1"
+  shift
+  if "$@"; then echo "   ok    $text"; else echo "   FAIL  $text"; failures=$((failures + 1)); fi
+}
+le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && b != "" && a + 0 <= b + 0) }'; }
+
+# Input the estimators lost (UDP under load; their "stopping:" lines): a
+# run that lost input is not the stack's undisturbed accuracy.
+losses() {
+  local p
+  for p in vins target_filter; do
+    printf ' %s %s' "$p" "$(grep -E "^\[([^]]*:)?$p\] .*stopping: in" "$1/sheriff.txt" |
+      sed -n 's/.* lost \([0-9]*\).*/\1/p' | awk '{ n += $1 } END { print n + 0 }')"
+  done
+}
+
+echo "== kill and recover ($mode), $VIMOT_SIM_CONFIG at ${VIMOT_SPEED}x, seed $VIMOT_SEED, kill at ${kill_at} s; output in $out"
+echo "== undisturbed run"
+run undisturbed
+for ch in VINS_STATE NAV_STATE TARGET_STATE; do
+  echo "   $ch position RMSE $(metric $ch "$out/undisturbed") m, longest silence $(gap "$out/undisturbed" $ch) s"
+done
+echo "   TARGET_STATE target in the IMU frame: position RMSE $(metric TARGET_IN_IMU "$out/undisturbed") m"
+echo "   IMU/FEATURES messages lost under load:$(losses "$out/undisturbed")"
+# The utime a restarted process last initialised at (its log line), empty if none.
+init_utime() {
+  grep -E "^\[([^]]*:)?$2\] .*initialised from ground truth at utime [0-9]+" "$1/sheriff.txt" | tail -n 1 |
+    grep -oE '[0-9]+$'
+}
+# ratio CHANNEL DIR_A DIR_B [info]: "a m <= 1.1 x b m" check of metric
+# CHANNEL; with "info" only printed.
+ratio() {
+  local a b text
+  a=$(metric "$1" "$2"); b=$(metric "$1" "$3")
+  text="$1 position RMSE $a m against $b m ($(awk -v a="$a" -v b="$b" 'BEGIN { if (b > 0) printf "%+.0f %%", 100 * (a / b - 1) }'))"
+  if [ "${4:-}" = info ]; then
+    echo "   info  $text"
+  else
+    check "$text, at most +10 %" le "$a" "$(awk -v b="$b" 'BEGIN { print 1.1 * b }')"
+  fi
+}
+
+for victim in $victims; do
+  echo "== kill $victim"
+  run "kill_$victim" "$victim"
+  d="$out/kill_$victim"
+  echo "   IMU/FEATURES messages lost under load:$(losses "$d")"
+  if [ $mode = local ]; then
+    check "$victim respawned" grep -q "respawned '$victim'" "$d/sheriff.txt"
+    others=$(grep -E "\[sheriff\] '[a-z_]+' exited" "$d/sheriff.txt" | grep -vE "'$victim' exited|'sim' exited with code 0" || true)
+  else
+    n=$(grep -oE "\] $host:$victim running \(pid [0-9]+\)" "$d/sheriff.txt" | sort -u | wc -l)
+    check "$victim respawned ($n runs)" [ "$n" -ge 2 ]
+    others=$(grep -E "\] $host:[a-z_]+ exited" "$d/sheriff.txt" | grep -vE ":$victim exited|:sim exited with code 0" || true)
+  fi
+  check "no other command exited${others:+: $others}" [ -z "$others" ]
+  case "$victim" in
+    vins) back="VINS_STATE"; steady="NAV_STATE TARGET_STATE"; restarted=vins; replay=(--vins "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG") ;;
+    target_filter) back="NAV_STATE TARGET_STATE"; steady="VINS_STATE"; restarted=target_filter
+                   replay=(--target-filter "$VIMOT_CONFIG/target_filter.yaml") ;;
+    sim) back="IMU VINS_STATE NAV_STATE TARGET_STATE"; steady=""; restarted=vins
+         replay=(--vins "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-filter "$VIMOT_CONFIG/target_filter.yaml") ;;
+  esac
+  for ch in $back; do g=$(gap "$d" $ch); check "$ch back within 3 s (longest silence $g s)" le "$g" 3; done
+  for ch in $steady; do g=$(gap "$d" $ch); check "$ch never silent over 1 s (longest $g s)" le "$g" 1; done
+  if [ "$victim" != vins ]; then
+    r=$(grep -oE 'target restarts \(gaps above 0.5 s\): [0-9]+' "$d/target_eval.txt" | grep -oE '[0-9]+$' || true)
+    check "target re-acquired (${r:-0} restart of the target in TARGET_STATE)" [ "${r:-0}" -ge 1 ]
+  fi
+  # Not a check: a fresh start mid-run is a different estimator from one
+  # running since t = 0 (docs/sheriff.md, "Recovery").
+  echo "   accuracy over the whole run against the undisturbed run:"
+  for ch in VINS_STATE NAV_STATE TARGET_STATE TARGET_IN_IMU; do ratio $ch "$d" "$out/undisturbed" info; done
+  # After the restart against a fresh start at the same point of the same
+  # data (the Nodes on this log from that utime, no network): what the
+  # recovery costs beyond starting the estimator anew.
+  u=$(init_utime "$d" $restarted)
+  if [ -z "$u" ]; then
+    check "$restarted logged its re-initialisation" false
+    continue
+  fi
+  "$bin/vimot-log-replay" "$d/run.lcmlog" --from-utime "$u" "${replay[@]}" --out "$d/fresh.lcmlog" > "$d/fresh.txt" 2>&1 || true
+  if grep -q "bit for bit identical" "$d/fresh.txt"; then
+    echo "   the restarted $restarted published exactly what a fresh start at utime $u computes (bit for bit)"
+  else
+    echo "   the restarted $restarted differs from a fresh start at utime $u (input it lost, or a process that re-initialised without restarting): $d/fresh.txt"
+  fi
+  evaluate "$d/after" "$d/run.lcmlog" --from-utime "$u"
+  evaluate "$d/fresh" "$d/fresh.lcmlog"
+  echo "   accuracy after the restart (utime $u on) against a fresh start there:"
+  case "$victim" in
+    vins) chans="VINS_STATE" ;;
+    target_filter) chans="NAV_STATE TARGET_STATE TARGET_IN_IMU" ;;
+    sim) chans="VINS_STATE NAV_STATE TARGET_STATE TARGET_IN_IMU" ;;
+  esac
+  for ch in $chans; do ratio $ch "$d/after" "$d/fresh"; done
+done
+trap - EXIT
+if [ $failures -eq 0 ]; then echo "== all checks passed"; exit 0; fi
+echo "== $failures checks failed" >&2
+exit 1
