@@ -23,7 +23,7 @@ inline std::function<void(const NodeEvent&)> report_events_to(Process& process) 
       case NodeEvent::Kind::kInfo: log_info(e.message); break;
       case NodeEvent::Kind::kDropped: process.report_dropped(e.message); break;
       case NodeEvent::Kind::kError: process.report_error(e.message); break;
-      case NodeEvent::Kind::kLost: process.report_lost(e.count, e.message); break;
+      case NodeEvent::Kind::kLost: process.report_lost(e.count, e.message, e.stream); break;
     }
   };
 }

@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
@@ -96,9 +97,20 @@ void Process::set_counter(const std::string& name, int64_t value) {
   extra_counters_.emplace_back(name, value);
 }
 
-void Process::report_lost(int64_t count, const std::string& why) {
+void Process::report_lost(int64_t count, const std::string& why, const std::string& stream) {
   counters_.lost += count;
+  if (!stream.empty()) {
+    auto it = std::find_if(lost_by_stream_.begin(), lost_by_stream_.end(),
+                           [&](const auto& sc) { return sc.first == stream; });
+    if (it == lost_by_stream_.end()) it = lost_by_stream_.insert(lost_by_stream_.end(), {stream, 0});
+    it->second += count;
+  }
   log_warn("lost: ", why);
+}
+
+void Process::update_stream_counters() {
+  for (const auto& s : subscriptions_) set_counter("in " + s->channel, s->received);
+  for (const auto& [stream, n] : lost_by_stream_) set_counter("lost " + stream, n);
 }
 
 bool Process::stop_requested() const { return stop_requested_ || g_signal_received; }
@@ -119,6 +131,7 @@ void Process::publish_heartbeat() {
       counters_.errors > 0 || counters_.dropped > 0 || counters_.lost > 0 || counters_.decode_errors > 0;
   hb.status = degraded ? "degraded" : "ok";
   hb.last_error = last_error_;
+  update_stream_counters();
   hb.num_counters = static_cast<int32_t>(extra_counters_.size());
   for (const auto& [n, v] : extra_counters_) {
     hb.counter_names.push_back(n);
@@ -145,9 +158,12 @@ int Process::run(const std::function<void()>& idle) {
     }
   }
   flush_suppressed_logs();
+  update_stream_counters();
+  std::string per_stream;
+  for (const auto& [n, v] : extra_counters_) per_stream += ", " + n + " " + std::to_string(v);
   log_info("stopping: in ", counters_.messages_in.load(), ", out ", counters_.messages_out.load(),
            ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(), ", lost ", counters_.lost.load(),
-           ", errors ", counters_.errors.load());
+           ", errors ", counters_.errors.load(), per_stream);
   return 0;
 }
 

@@ -81,13 +81,17 @@ class Process {
   void report_error(const std::string& what);
   /// Counts dropped input (late, duplicate, out-of-order) with a reason.
   void report_dropped(const std::string& why);
-  /// Counts `count` input messages that never arrived (a gap in a stream's
-  /// utime against its expected rate).
-  void report_lost(int64_t count, const std::string& why);
+  /// Counts `count` input messages of `stream` that never arrived (a gap in
+  /// its utime against its expected rate); per stream in the heartbeat's
+  /// counters as "lost <stream>".
+  void report_lost(int64_t count, const std::string& why, const std::string& stream = "");
 
   /// Sets a process-specific cumulative counter carried by the heartbeat
-  /// (counter_names / counter_values, in first-set order). Call from the
-  /// thread that publishes the heartbeat.
+  /// (counter_names / counter_values, in first-set order) and the log line
+  /// at exit. Call from the thread that publishes the heartbeat. The
+  /// scaffold adds "in <channel>" (messages received per subscribed
+  /// channel) and "lost <stream>" (report_lost), so a count of what a source
+  /// published can be checked against what arrived and what was said lost.
   void set_counter(const std::string& name, int64_t value);
 
   /// Handles LCM until stop() or a signal; sends a heartbeat every second.
@@ -118,7 +122,10 @@ class Process {
     Process* owner;
     std::string channel;
     std::function<bool(const void*, int)> decode_and_call;
+    int64_t received{0};
   };
+  void update_stream_counters();
+  std::vector<std::pair<std::string, int64_t>> lost_by_stream_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
 };
 
@@ -138,6 +145,7 @@ void Process::subscribe(const std::string& channel, std::function<void(const Msg
   lcm_->subscribeFunction(
       channel,
       +[](const lcm::ReceiveBuffer* rbuf, const std::string& chan, RawSubscription* s) {
+        ++s->received;
         s->owner->handle_raw(rbuf, chan, s->decode_and_call);
       },
       raw);

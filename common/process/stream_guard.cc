@@ -1,7 +1,9 @@
 #include "common/process/stream_guard.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace vimot {
 
@@ -22,6 +24,7 @@ StreamGuard::StreamGuard(std::string name, const StreamGuardOptions& options)
 void StreamGuard::reset() {
   has_last_ = false;
   suspects_ = 0;
+  rejected_since_accept_ = 0;
 }
 
 StreamCheck StreamGuard::check(int64_t utime) {
@@ -49,6 +52,7 @@ StreamCheck StreamGuard::check(int64_t utime) {
       return out;
     }
     ++rejected_;
+    ++rejected_since_accept_;
     out.verdict = StreamVerdict::kRejectJump;
     out.message = name_ + " at utime " + std::to_string(utime) + " jumps " + std::to_string(step_s) +
                   " s from the stream's clock (limits +" + std::to_string(options_.max_forward_jump_s) + " / -" +
@@ -57,8 +61,11 @@ StreamCheck StreamGuard::check(int64_t utime) {
   }
   suspects_ = 0;
   if (step_s <= 0.0) return out;
+  // A rejected message (a bad stamp on a sample that did arrive) took one of
+  // the gap's slots: it is counted as rejected, not again as lost.
+  const int64_t rejected_in_gap = std::exchange(rejected_since_accept_, 0);
   if (options_.expected_period_s > 0.0 && step_s > 1.5 * options_.expected_period_s) {
-    out.lost = std::llround(step_s / options_.expected_period_s) - 1;
+    out.lost = std::max<int64_t>(0, std::llround(step_s / options_.expected_period_s) - 1 - rejected_in_gap);
     if (out.lost > 0) {
       lost_ += out.lost;
       out.message = std::to_string(out.lost) + " " + name_ + " message(s) lost before utime " + std::to_string(utime) +

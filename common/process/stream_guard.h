@@ -3,7 +3,9 @@
 // bounds how far one message may jump from the stream's clock, tells a
 // single bad timestamp (rejected, the clock kept) from a source whose clock
 // really moved (several consistent jumps: a source reset), and counts input
-// lost on the way (utime gaps against the expected period). No LCM.
+// lost on the way (utime gaps against the expected period; a rejected
+// message fills one slot of the gap, so each missing sample is counted
+// once, as rejected or as lost). No LCM.
 // Thresholds and what the nodes do: docs/robustness.md.
 
 #include <cstdint>
@@ -41,6 +43,9 @@ class StreamGuard {
   /// Forgets the clock: the next message is taken as the first.
   void reset();
 
+  const std::string& name() const { return name_; }
+  /// False until the first message (or after reset()).
+  bool started() const { return has_last_; }
   int64_t lost() const { return lost_; }
   int64_t rejected() const { return rejected_; }
   int64_t source_resets() const { return source_resets_; }
@@ -52,6 +57,7 @@ class StreamGuard {
   int64_t last_{0};
   int suspects_{0};
   int64_t last_suspect_{0};
+  int64_t rejected_since_accept_{0};
   int64_t lost_{0};
   int64_t rejected_{0};
   int64_t source_resets_{0};

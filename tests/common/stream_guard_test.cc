@@ -66,3 +66,21 @@ TEST_CASE("gaps count the messages lost against the expected period") {
   u.check(0);
   CHECK(u.check(400'000).lost == 0);
 }
+
+TEST_CASE("a rejected message fills its slot: each missing sample counted once") {
+  StreamGuard g("IMU", options());
+  g.check(0);
+  CHECK(g.check(5'000).lost == 0);
+  // The sample of 10 ms arrives with a bad stamp: rejected, not lost too.
+  CHECK(g.check(1'000'010'000).verdict == StreamVerdict::kRejectJump);
+  CHECK(g.check(15'000).lost == 0);
+  // 20 and 25 ms never arrive, 30 ms comes stamped in the past: 2 lost, 1 rejected.
+  CHECK(g.check(-1'000'000).verdict == StreamVerdict::kRejectJump);
+  CHECK(g.check(35'000).lost == 2);
+  CHECK(g.lost() == 2);
+  CHECK(g.rejected() == 2);
+  // A rejected message where no slot was missing does not hide a later gap.
+  CHECK(g.check(900'000'000).verdict == StreamVerdict::kRejectJump);
+  CHECK(g.check(40'000).lost == 0);
+  CHECK(g.check(50'000).lost == 1);
+}
