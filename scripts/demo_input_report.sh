@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Per process and input stream of a demo run: what the simulator published,
+# what the process received, and what its heartbeat counted as lost (from
+# the sheriff's output: the simulator's "done:" line and each process's
+# "stopping:" line, common/process/process.h). Published − received is what
+# the network lost; a process that counts its input exactly says the same.
+#   scripts/demo_input_report.sh SHERIFF_OUTPUT
+# Exits 1 if some process's count differs from what it missed.
+set -euo pipefail
+if [ $# -ne 1 ] || [ "$1" = -h ] || [ "$1" = --help ]; then
+  awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"
+  [ $# -eq 1 ] && exit 0 || exit 1
+fi
+[ -r "$1" ] || { echo "demo_input_report.sh: cannot read '$1'" >&2; exit 1; }
+awk '
+  function items(text, out,   n, parts, i) { n = split(text, parts, ", "); for (i = 1; i <= n; ++i) out[i] = parts[i]; return n }
+  /\[sim\].*INFO: (done|stopped early): / {
+    text = $0; sub(/.*INFO: (done|stopped early): /, "", text)
+    n = items(text, it)
+    for (i = 1; i <= n; ++i) { split(it[i], w, " "); if (w[2] == "on") { published[w[3]] = w[1]; streams[++ns] = w[3] } }
+  }
+  /INFO: stopping: in / {
+    name = $1; gsub(/[][]/, "", name)
+    text = $0; sub(/.*INFO: stopping: /, "", text)
+    if (!(name in seen)) { seen[name] = 1; procs[++np] = name }
+    n = items(text, it)
+    for (i = 1; i <= n; ++i) {
+      k = split(it[i], w, " ")
+      if (k == 3 && (w[1] == "in" || w[1] == "lost")) count[name, w[1], w[2]] = w[3]
+      if (k == 2 && (w[1] == "dropped" || w[1] == "lost" || w[1] == "errors")) count[name, w[1]] = w[2]
+    }
+  }
+  END {
+    if (ns == 0) { print "no \"done:\" line of the simulator: nothing to compare"; exit 1 }
+    status = 0
+    for (p = 1; p <= np; ++p) {
+      name = procs[p]; rows = ""
+      for (s = 1; s <= ns; ++s) {
+        ch = streams[s]
+        if (!((name, "in", ch) in count)) continue
+        missed = published[ch] - count[name, "in", ch]; lost = count[name, "lost", ch] + 0
+        rows = rows sprintf("  %-13s published %6d  received %6d  counted lost %d", ch, published[ch], count[name, "in", ch], lost)
+        if (missed != lost) { rows = rows sprintf("  MISCOUNTED: %d missed", missed); status = 1 }
+        rows = rows "\n"
+      }
+      if (rows != "") printf "%s (dropped %d, lost %d, errors %d):\n%s", name, count[name, "dropped"], count[name, "lost"], count[name, "errors"], rows
+    }
+    exit status
+  }' "$1"
