@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdlib>
 #include <iostream>
 
@@ -150,6 +151,7 @@ int Process::run(const std::function<void()>& idle) {
       report_error("LCM handle failed");
       return 1;
     }
+    idle_after_timeout_ = status == 0;
     if (idle) idle();
     if (Clock::now() >= next_heartbeat) {
       publish_heartbeat();
@@ -163,7 +165,8 @@ int Process::run(const std::function<void()>& idle) {
   for (const auto& [n, v] : extra_counters_) per_stream += ", " + n + " " + std::to_string(v);
   log_info("stopping: in ", counters_.messages_in.load(), ", out ", counters_.messages_out.load(),
            ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(), ", lost ", counters_.lost.load(),
-           ", errors ", counters_.errors.load(), per_stream);
+           ", errors ", counters_.errors.load(), per_stream, ", cpu ",
+           static_cast<double>(std::clock()) / CLOCKS_PER_SEC, " s");
   return 0;
 }
 
