@@ -4,15 +4,25 @@
 # the sheriff's output: the simulator's "done:" line and each process's
 # "stopping:" line, common/process/process.h). Published − received is what
 # the network lost; a process that counts its input exactly says the same.
-#   scripts/demo_input_report.sh SHERIFF_OUTPUT
+# With the run's LCM log: also what each process published against what
+# the logger recorded (the logger has no heartbeat; its loss changes the
+# figures evaluated from the log too).
+#   scripts/demo_input_report.sh SHERIFF_OUTPUT [LCM_LOG]
 # Exits 1 if some process's count differs from what it missed.
 set -euo pipefail
-if [ $# -ne 1 ] || [ "$1" = -h ] || [ "$1" = --help ]; then
+if [ $# -lt 1 ] || [ $# -gt 2 ] || [ "$1" = -h ] || [ "$1" = --help ]; then
   awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"
   [ $# -eq 1 ] && exit 0 || exit 1
 fi
 [ -r "$1" ] || { echo "demo_input_report.sh: cannot read '$1'" >&2; exit 1; }
+logged=$(mktemp)
+trap 'rm -f "$logged"' EXIT
+if [ $# -eq 2 ]; then
+  bin="${VIMOT_BIN:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/build/bin}"
+  "$bin/vimot-log-summary" "$2" > "$logged"
+fi
 awk '
+  FILENAME == ARGV[1] { if ($2 ~ /^vimot\./) logged[$1] = $3; next }
   function items(text, out,   n, parts, i) { n = split(text, parts, ", "); for (i = 1; i <= n; ++i) out[i] = parts[i]; return n }
   /\[sim\].*INFO: (done|stopped early): / {
     text = $0; sub(/.*INFO: (done|stopped early): /, "", text)
@@ -26,13 +36,18 @@ awk '
     n = items(text, it)
     for (i = 1; i <= n; ++i) {
       k = split(it[i], w, " ")
-      if (k == 3 && (w[1] == "in" || w[1] == "lost")) count[name, w[1], w[2]] = w[3]
+      if (k == 3 && (w[1] == "in" || w[1] == "lost" || w[1] == "out")) count[name, w[1], w[2]] = w[3]
+      if (k == 3 && w[1] == "out") outs[name] = outs[name] " " w[2]
       if (k == 2 && (w[1] == "dropped" || w[1] == "lost" || w[1] == "errors")) count[name, w[1]] = w[2]
     }
   }
   END {
     if (ns == 0) { print "no \"done:\" line of the simulator: nothing to compare"; exit 1 }
     status = 0
+    if (length(logged) > 0) {
+      printf "logger:\n"
+      for (s = 1; s <= ns; ++s) printf "  %-13s published %6d  logged   %6d\n", streams[s], published[streams[s]], logged[streams[s]]
+    }
     for (p = 1; p <= np; ++p) {
       name = procs[p]; rows = ""
       for (s = 1; s <= ns; ++s) {
@@ -43,7 +58,13 @@ awk '
         if (missed != lost) { rows = rows sprintf("  MISCOUNTED: %d missed", missed); status = 1 }
         rows = rows "\n"
       }
+      if (length(logged) > 0) {
+        n = split(outs[name], chans, " ")
+        for (i = 1; i <= n; ++i) {
+          rows = rows sprintf("  %-13s published %6d  logged   %6d\n", chans[i], count[name, "out", chans[i]], logged[chans[i]])
+        }
+      }
       if (rows != "") printf "%s (dropped %d, lost %d, errors %d):\n%s", name, count[name, "dropped"], count[name, "lost"], count[name, "errors"], rows
     }
     exit status
-  }' "$1"
+  }' "$logged" "$1"

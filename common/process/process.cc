@@ -98,20 +98,27 @@ void Process::set_counter(const std::string& name, int64_t value) {
   extra_counters_.emplace_back(name, value);
 }
 
+namespace {
+// Adds `n` to the count of `key` (kept in first-seen order).
+void add_count(std::vector<std::pair<std::string, int64_t>>* counts, const std::string& key, int64_t n) {
+  auto it = std::find_if(counts->begin(), counts->end(), [&](const auto& kc) { return kc.first == key; });
+  if (it == counts->end()) it = counts->insert(counts->end(), {key, 0});
+  it->second += n;
+}
+}  // namespace
+
 void Process::report_lost(int64_t count, const std::string& why, const std::string& stream) {
   counters_.lost += count;
-  if (!stream.empty()) {
-    auto it = std::find_if(lost_by_stream_.begin(), lost_by_stream_.end(),
-                           [&](const auto& sc) { return sc.first == stream; });
-    if (it == lost_by_stream_.end()) it = lost_by_stream_.insert(lost_by_stream_.end(), {stream, 0});
-    it->second += count;
-  }
+  if (!stream.empty()) add_count(&lost_by_stream_, stream, count);
   log_warn("lost: ", why);
 }
+
+void Process::count_published(const std::string& channel) { add_count(&out_by_channel_, channel, 1); }
 
 void Process::update_stream_counters() {
   for (const auto& s : subscriptions_) set_counter("in " + s->channel, s->received);
   for (const auto& [stream, n] : lost_by_stream_) set_counter("lost " + stream, n);
+  for (const auto& [channel, n] : out_by_channel_) set_counter("out " + channel, n);
 }
 
 bool Process::stop_requested() const { return stop_requested_ || g_signal_received; }

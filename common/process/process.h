@@ -75,6 +75,7 @@ class Process {
   void publish(const std::string& channel, const Msg& msg) {
     if (lcm_->publish(channel, &msg) == 0) {
       ++counters_.messages_out;
+      count_published(channel);
     } else {
       report_error("publish on " + channel + " failed");
     }
@@ -93,8 +94,9 @@ class Process {
   /// (counter_names / counter_values, in first-set order) and the log line
   /// at exit. Call from the thread that publishes the heartbeat. The
   /// scaffold adds "in <channel>" (messages received per subscribed
-  /// channel) and "lost <stream>" (report_lost), so a count of what a source
-  /// published can be checked against what arrived and what was said lost.
+  /// channel), "lost <stream>" (report_lost) and "out <channel>"
+  /// (published), so what a source published can be checked against what
+  /// arrived and what was said lost (scripts/demo_input_report.sh).
   void set_counter(const std::string& name, int64_t value);
 
   /// Handles LCM until stop() or a signal; sends a heartbeat every second.
@@ -132,7 +134,9 @@ class Process {
     int64_t received{0};
   };
   void update_stream_counters();
+  void count_published(const std::string& channel);
   std::vector<std::pair<std::string, int64_t>> lost_by_stream_;
+  std::vector<std::pair<std::string, int64_t>> out_by_channel_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
 };
 

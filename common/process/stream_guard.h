@@ -18,6 +18,10 @@ struct StreamGuardOptions {
   double max_forward_jump_s{1.0};    // a step further ahead is suspect
   double max_backward_jump_s{1.0};   // a step further back is suspect (smaller: left to the consumer)
   int reset_after{3};                // consecutive consistent suspect messages that make a source reset
+  /// A source reset forward by at most this is an outage (e.g. a process
+  /// that fell behind and whose input queue overflowed): the messages it
+  /// skipped count as lost. Further: a new clock, nothing counted.
+  double max_outage_s{60.0};
 
   /// Throws std::invalid_argument naming the bad option.
   void validate() const;
@@ -31,7 +35,7 @@ enum class StreamVerdict {
 
 struct StreamCheck {
   StreamVerdict verdict{StreamVerdict::kAccept};
-  int64_t lost{0};       // messages missing before this one (kAccept only)
+  int64_t lost{0};       // messages missing before this one (kAccept, or kSourceReset after an outage)
   std::string message;   // why, for the log (empty when accepted without loss)
 };
 
@@ -40,7 +44,8 @@ class StreamGuard {
   StreamGuard(std::string name, const StreamGuardOptions& options);
 
   StreamCheck check(int64_t utime);
-  /// Forgets the clock: the next message is taken as the first.
+  /// Forgets the clock: the next message is taken as the first (a step
+  /// forward from the old clock up to max_outage_s still counts as lost).
   void reset();
 
   const std::string& name() const { return name_; }
@@ -53,7 +58,12 @@ class StreamGuard {
  private:
   std::string name_;
   StreamGuardOptions options_;
+  /// Counts the messages a forward step of `step_s` skipped (less those
+  /// rejected in it) into out->lost when it is an outage; returns the count.
+  int64_t count_outage(double step_s, StreamCheck* out);
+
   bool has_last_{false};
+  bool has_old_{false};  // last_ is a clock from before reset()
   int64_t last_{0};
   int suspects_{0};
   int64_t last_suspect_{0};

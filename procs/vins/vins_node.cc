@@ -39,12 +39,13 @@ InputGuardOptions input_guard_options_from_config(const Config& cfg) {
       {"imu", &o.imu}, {"features", &o.features}, {"ground_truth", &o.ground_truth}};
   for (const auto& [name, s] : streams) {
     const std::string k = std::string("input.") + name;
-    cfg.check_keys(k, {"rate_hz", "max_forward_jump_s", "max_backward_jump_s"});
+    cfg.check_keys(k, {"rate_hz", "max_forward_jump_s", "max_backward_jump_s", "max_outage_s"});
     const double rate = cfg.get_or<double>(k + ".rate_hz", 0.0);
     if (!(rate >= 0.0) || !std::isfinite(rate)) cfg.fail(k + ".rate_hz", "must be finite and >= 0");
     s->expected_period_s = rate > 0.0 ? 1.0 / rate : 0.0;
     s->max_forward_jump_s = cfg.get_or<double>(k + ".max_forward_jump_s", s->max_forward_jump_s);
     s->max_backward_jump_s = cfg.get_or<double>(k + ".max_backward_jump_s", s->max_backward_jump_s);
+    s->max_outage_s = cfg.get_or<double>(k + ".max_outage_s", s->max_outage_s);
     s->reset_after = reset_after;
   }
   o.max_gyro_radps = cfg.get_or<double>("input.max_gyro_radps", o.max_gyro_radps);
@@ -147,6 +148,7 @@ bool VinsNode::admit(StreamGuard& guard, int64_t utime) {
       say(NodeEvent::Kind::kDropped, c.message);
       return false;
     case StreamVerdict::kSourceReset:
+      if (c.lost > 0 && on_event_) on_event_(NodeEvent{NodeEvent::Kind::kLost, c.message, c.lost, guard.name()});
       if (&guard == &truth_guard_) {
         say(NodeEvent::Kind::kInfo, c.message);  // not an input of the estimate: only its clock restarts
         return true;

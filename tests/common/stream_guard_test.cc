@@ -84,3 +84,29 @@ TEST_CASE("a rejected message fills its slot: each missing sample counted once")
   CHECK(g.check(40'000).lost == 0);
   CHECK(g.check(50'000).lost == 1);
 }
+
+TEST_CASE("an outage longer than a jump is a source reset that counts what it skipped") {
+  StreamGuard g("IMU", options());
+  g.check(0);
+  // 0.7 s of messages never arrived (a queue overflowed): 139 missing, then
+  // 2 rejected as suspects before the third makes the reset.
+  CHECK(g.check(700'000).verdict == StreamVerdict::kRejectJump);
+  CHECK(g.check(705'000).verdict == StreamVerdict::kRejectJump);
+  const auto c = g.check(710'000);
+  CHECK(c.verdict == StreamVerdict::kSourceReset);
+  CHECK(c.lost == 139);
+  CHECK(g.check(715'000).lost == 0);
+  // Another stream's source reset restarts this clock: a forward step from
+  // the old one is still counted, a step back (a clock moved back) is not.
+  g.reset();
+  CHECK(g.check(815'000).lost == 19);
+  g.reset();
+  CHECK(g.check(100'000).lost == 0);
+  CHECK(g.check(105'000).lost == 0);
+  // A clock moved far ahead (beyond max_outage_s) is no outage.
+  for (int64_t t : {900'000'000, 900'005'000}) CHECK(g.check(t).verdict == StreamVerdict::kRejectJump);
+  const auto far = g.check(900'010'000);
+  CHECK(far.verdict == StreamVerdict::kSourceReset);
+  CHECK(far.lost == 0);
+  CHECK(g.lost() == 139 + 19);
+}
