@@ -8,7 +8,9 @@
 # the logger recorded (the logger has no heartbeat; its loss changes the
 # figures evaluated from the log too).
 #   scripts/demo_input_report.sh SHERIFF_OUTPUT [LCM_LOG]
-# Exits 1 if some process's count differs from what it missed.
+# Exits 1 if some process's count differs from what it missed ("NOT COUNTED":
+# e.g. input still queued, or lost at the end, when the process was stopped:
+# no later message shows the gap).
 set -euo pipefail
 if [ $# -lt 1 ] || [ $# -gt 2 ] || [ "$1" = -h ] || [ "$1" = --help ]; then
   awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"
@@ -55,7 +57,7 @@ awk '
         if (!((name, "in", ch) in count)) continue
         missed = published[ch] - count[name, "in", ch]; lost = count[name, "lost", ch] + 0
         rows = rows sprintf("  %-13s published %6d  received %6d  counted lost %d", ch, published[ch], count[name, "in", ch], lost)
-        if (missed != lost) { rows = rows sprintf("  MISCOUNTED: %d missed", missed); status = 1 }
+        if (missed != lost) { rows = rows sprintf("  NOT COUNTED: %d missed", missed); status = 1 }
         rows = rows "\n"
       }
       if (length(logged) > 0) {
