@@ -164,7 +164,8 @@ finish() {
   if [ "$lcm_vs_offline" -ne 0 ]; then
     echo "demo: the LCM run differs from the offline run of the same seed (vimot-log-eval exit $lcm_vs_offline):" >&2
     grep -E 'tolerance|error' "$out/lcm_vs_offline.txt" | sed 's/^/   /' >&2 || true
-    echo "   messages were lost or processed late; see the heartbeats' dropped counts in $out/sheriff.txt" >&2
+    echo "   input of each process (its heartbeat's counts; all in $out/sheriff.txt):" >&2
+    "$here/scripts/demo_input_report.sh" "$out/sheriff.txt" "$VIMOT_LOG" | sed 's/^/   /' >&2 || true
     exit 4
   fi
   exit 0

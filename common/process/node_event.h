@@ -14,6 +14,7 @@ struct NodeEvent {
   enum class Kind { kInfo, kDropped, kError, kLost } kind{Kind::kInfo};
   std::string message;
   int64_t count{1};
+  std::string stream{};  // kLost: which input stream (IMU, FEATURES, GROUND_TRUTH)
 };
 
 }  // namespace vimot

@@ -23,7 +23,7 @@ inline std::function<void(const NodeEvent&)> report_events_to(Process& process) 
       case NodeEvent::Kind::kInfo: log_info(e.message); break;
       case NodeEvent::Kind::kDropped: process.report_dropped(e.message); break;
       case NodeEvent::Kind::kError: process.report_error(e.message); break;
-      case NodeEvent::Kind::kLost: process.report_lost(e.count, e.message); break;
+      case NodeEvent::Kind::kLost: process.report_lost(e.count, e.message, e.stream); break;
     }
   };
 }
@@ -31,24 +31,39 @@ inline std::function<void(const NodeEvent&)> report_events_to(Process& process) 
 /// Subscribes IMU, FEATURES and (if `use_ground_truth`) GROUND_TRUTH to the
 /// node and handles LCM until stopped. If the IMU stream stops for
 /// `max_wait_s` of wall time, queued frames are processed with the data
-/// there is rather than held forever. Returns the process's exit status.
+/// there is rather than held forever. Only a quiet network counts as a
+/// stop: after a frame update that took long on a loaded CPU, the IMU
+/// samples waiting in the socket come first (else the next frame would be
+/// processed without them, unlike offline). Returns the exit status.
 template <typename Node>
 int run_estimator_node(Process& process, Node& node, bool use_ground_truth, double max_wait_s) {
   using Clock = std::chrono::steady_clock;
   Clock::time_point last_imu_wall = Clock::now();
-  process.subscribe<imu_t>(process.channel("imu", "IMU"), [&](const imu_t& m) {
-    last_imu_wall = Clock::now();
-    node.on_imu(from_lcm(m));
-  });
-  process.subscribe<features_t>(process.channel("features", "FEATURES"),
-                                [&](const features_t& m) { node.on_frame(from_lcm(m)); });
+  // 10 s of input at the simulator's 200 Hz IMU and ground truth, 10 Hz
+  // frames (≈ 3 MB at most) wait while a frame update runs long on a loaded
+  // CPU; LCM's default queue (30 messages, 0.15 s of IMU) dropped them.
+  constexpr int kImuQueue = 2000, kFeaturesQueue = 100;
+  process.subscribe<imu_t>(
+      process.channel("imu", "IMU"),
+      [&](const imu_t& m) {
+        node.on_imu(from_lcm(m));
+        last_imu_wall = Clock::now();  // after the frames this sample released were processed
+      },
+      kImuQueue);
+  process.subscribe<features_t>(
+      process.channel("features", "FEATURES"), [&](const features_t& m) { node.on_frame(from_lcm(m)); },
+      kFeaturesQueue);
   if (use_ground_truth) {
-    process.subscribe<ground_truth_t>(process.channel("ground_truth", "GROUND_TRUTH"),
-                                      [&](const ground_truth_t& m) { node.on_ground_truth(from_lcm(m)); });
+    process.subscribe<ground_truth_t>(
+        process.channel("ground_truth", "GROUND_TRUTH"),
+        [&](const ground_truth_t& m) { node.on_ground_truth(from_lcm(m)); }, kImuQueue);
   }
   log_info(use_ground_truth ? "waiting for GROUND_TRUTH to initialise" : "initialising at rest from the IMU");
   const int status = process.run([&] {
-    if (std::chrono::duration<double>(Clock::now() - last_imu_wall).count() > max_wait_s) node.flush();
+    if (process.idle_after_timeout() &&
+        std::chrono::duration<double>(Clock::now() - last_imu_wall).count() > max_wait_s) {
+      node.flush();
+    }
   });
   node.flush();
   log_info("processed ", node.frames_processed(), " frames, ", node.resets(), " resets");

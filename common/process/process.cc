@@ -3,7 +3,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdlib>
 #include <iostream>
 
@@ -96,9 +98,27 @@ void Process::set_counter(const std::string& name, int64_t value) {
   extra_counters_.emplace_back(name, value);
 }
 
-void Process::report_lost(int64_t count, const std::string& why) {
+namespace {
+// Adds `n` to the count of `key` (kept in first-seen order).
+void add_count(std::vector<std::pair<std::string, int64_t>>* counts, const std::string& key, int64_t n) {
+  auto it = std::find_if(counts->begin(), counts->end(), [&](const auto& kc) { return kc.first == key; });
+  if (it == counts->end()) it = counts->insert(counts->end(), {key, 0});
+  it->second += n;
+}
+}  // namespace
+
+void Process::report_lost(int64_t count, const std::string& why, const std::string& stream) {
   counters_.lost += count;
+  if (!stream.empty()) add_count(&lost_by_stream_, stream, count);
   log_warn("lost: ", why);
+}
+
+void Process::count_published(const std::string& channel) { add_count(&out_by_channel_, channel, 1); }
+
+void Process::update_stream_counters() {
+  for (const auto& s : subscriptions_) set_counter("in " + s->channel, s->received);
+  for (const auto& [stream, n] : lost_by_stream_) set_counter("lost " + stream, n);
+  for (const auto& [channel, n] : out_by_channel_) set_counter("out " + channel, n);
 }
 
 bool Process::stop_requested() const { return stop_requested_ || g_signal_received; }
@@ -119,6 +139,7 @@ void Process::publish_heartbeat() {
       counters_.errors > 0 || counters_.dropped > 0 || counters_.lost > 0 || counters_.decode_errors > 0;
   hb.status = degraded ? "degraded" : "ok";
   hb.last_error = last_error_;
+  update_stream_counters();
   hb.num_counters = static_cast<int32_t>(extra_counters_.size());
   for (const auto& [n, v] : extra_counters_) {
     hb.counter_names.push_back(n);
@@ -137,6 +158,7 @@ int Process::run(const std::function<void()>& idle) {
       report_error("LCM handle failed");
       return 1;
     }
+    idle_after_timeout_ = status == 0;
     if (idle) idle();
     if (Clock::now() >= next_heartbeat) {
       publish_heartbeat();
@@ -145,9 +167,13 @@ int Process::run(const std::function<void()>& idle) {
     }
   }
   flush_suppressed_logs();
+  update_stream_counters();
+  std::string per_stream;
+  for (const auto& [n, v] : extra_counters_) per_stream += ", " + n + " " + std::to_string(v);
   log_info("stopping: in ", counters_.messages_in.load(), ", out ", counters_.messages_out.load(),
            ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(), ", lost ", counters_.lost.load(),
-           ", errors ", counters_.errors.load());
+           ", errors ", counters_.errors.load(), per_stream, ", cpu ",
+           static_cast<double>(std::clock()) / CLOCKS_PER_SEC, " s");
   return 0;
 }
 

@@ -65,13 +65,17 @@ class Process {
   /// Subscribes with decoding done here (decode_untrusted: lengths checked
   /// before anything is allocated), so a malformed message is counted as a
   /// decode error and logged (rate-limited), never a crash.
+  /// `queue_capacity`: messages LCM holds for this channel while the handler
+  /// thread is busy; LCM silently drops what comes beyond (0: LCM's
+  /// default, 30 — 0.15 s of a 200 Hz stream).
   template <typename Msg>
-  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler);
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity = 0);
 
   template <typename Msg>
   void publish(const std::string& channel, const Msg& msg) {
     if (lcm_->publish(channel, &msg) == 0) {
       ++counters_.messages_out;
+      count_published(channel);
     } else {
       report_error("publish on " + channel + " failed");
     }
@@ -81,18 +85,26 @@ class Process {
   void report_error(const std::string& what);
   /// Counts dropped input (late, duplicate, out-of-order) with a reason.
   void report_dropped(const std::string& why);
-  /// Counts `count` input messages that never arrived (a gap in a stream's
-  /// utime against its expected rate).
-  void report_lost(int64_t count, const std::string& why);
+  /// Counts `count` input messages of `stream` that never arrived (a gap in
+  /// its utime against its expected rate); per stream in the heartbeat's
+  /// counters as "lost <stream>".
+  void report_lost(int64_t count, const std::string& why, const std::string& stream = "");
 
   /// Sets a process-specific cumulative counter carried by the heartbeat
-  /// (counter_names / counter_values, in first-set order). Call from the
-  /// thread that publishes the heartbeat.
+  /// (counter_names / counter_values, in first-set order) and the log line
+  /// at exit. Call from the thread that publishes the heartbeat. The
+  /// scaffold adds "in <channel>" (messages received per subscribed
+  /// channel), "lost <stream>" (report_lost) and "out <channel>"
+  /// (published), so what a source published can be checked against what
+  /// arrived and what was said lost (scripts/demo_input_report.sh).
   void set_counter(const std::string& name, int64_t value);
 
   /// Handles LCM until stop() or a signal; sends a heartbeat every second.
   /// `idle` runs after each handled batch or timeout (e.g. deferred work).
   int run(const std::function<void()>& idle = {});
+  /// In `idle`: the wait before it timed out, so no input is pending (a
+  /// quiet network, not a backlog left by a long handler on a busy CPU).
+  bool idle_after_timeout() const { return idle_after_timeout_; }
   void stop() { stop_requested_ = true; }
   bool stop_requested() const;
 
@@ -112,18 +124,24 @@ class Process {
   std::string last_error_;
   std::vector<std::pair<std::string, int64_t>> extra_counters_;
   std::atomic<bool> stop_requested_{false};
+  bool idle_after_timeout_{false};
 
   // Subscriptions keep their closures alive for the LCM callbacks.
   struct RawSubscription {
     Process* owner;
     std::string channel;
     std::function<bool(const void*, int)> decode_and_call;
+    int64_t received{0};
   };
+  void update_stream_counters();
+  void count_published(const std::string& channel);
+  std::vector<std::pair<std::string, int64_t>> lost_by_stream_;
+  std::vector<std::pair<std::string, int64_t>> out_by_channel_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
 };
 
 template <typename Msg>
-void Process::subscribe(const std::string& channel, std::function<void(const Msg&)> handler) {
+void Process::subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity) {
   auto sub = std::make_unique<RawSubscription>();
   sub->owner = this;
   sub->channel = channel;
@@ -135,12 +153,14 @@ void Process::subscribe(const std::string& channel, std::function<void(const Msg
   };
   RawSubscription* raw = sub.get();
   subscriptions_.push_back(std::move(sub));
-  lcm_->subscribeFunction(
+  lcm::Subscription* lcm_sub = lcm_->subscribeFunction(
       channel,
       +[](const lcm::ReceiveBuffer* rbuf, const std::string& chan, RawSubscription* s) {
+        ++s->received;
         s->owner->handle_raw(rbuf, chan, s->decode_and_call);
       },
       raw);
+  if (queue_capacity > 0 && lcm_sub != nullptr) lcm_sub->setQueueCapacity(queue_capacity);
 }
 
 /// Runs a process main, turning any escaping exception into a one-line error

@@ -106,14 +106,13 @@ void TargetFilterNode::on_frame(const CameraFrame& frame) { vins_.on_frame(frame
 void TargetFilterNode::flush() { vins_.flush(); }
 
 void TargetFilterNode::on_ground_truth(const GroundTruth& message) {
-  GroundTruth truth = message;
-  if (!vins_.check_ground_truth(&truth)) return;  // unit quaternions from here on
+  GroundTruth truth;
+  if (!vins_.on_ground_truth(message, &truth)) return;  // unit quaternions from here on
   if (filter_ && truth.has_target && options_.target.init_mode == target::TargetInitMode::kGroundTruth) {
     truths_[truth.utime] = truth;
     const int64_t keep_from = truth.utime - static_cast<int64_t>(options_.ground_truth_buffer_s * 1e6);
     while (!truths_.empty() && truths_.begin()->first < keep_from) truths_.erase(truths_.begin());
   }
-  vins_.on_ground_truth(truth);
 }
 
 void TargetFilterNode::before_frame(const CameraFrame& frame) {

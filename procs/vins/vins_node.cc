@@ -11,9 +11,11 @@
 namespace vimot {
 
 void InputGuardOptions::validate() const {
-  for (const StreamGuardOptions* s : {&imu, &features}) s->validate();
+  for (const StreamGuardOptions* s : {&imu, &features, &ground_truth}) s->validate();
   if (!(max_gyro_radps > 0.0)) throw std::invalid_argument("max_gyro_radps: must be > 0");
   if (!(max_accel_mps2 > 0.0)) throw std::invalid_argument("max_accel_mps2: must be > 0");
+  if (!(max_normalized > 0.0)) throw std::invalid_argument("max_normalized: must be > 0");
+  if (!(max_pixels_outside >= 0.0)) throw std::invalid_argument("max_pixels_outside: must be >= 0");
   if (!(max_imu_gap_s > 0.0)) throw std::invalid_argument("max_imu_gap_s: must be > 0");
   if (max_rejected_frames < 1) throw std::invalid_argument("max_rejected_frames: must be >= 1");
   if (consistency_window < 1) throw std::invalid_argument("consistency_window: must be >= 1");
@@ -29,24 +31,27 @@ void InputGuardOptions::validate() const {
 InputGuardOptions input_guard_options_from_config(const Config& cfg) {
   InputGuardOptions o;
   if (!cfg.has("input")) return o;
-  cfg.check_keys("input", {"imu", "features", "source_reset_after", "max_gyro_radps",
-                           "max_accel_mps2", "max_imu_gap_s", "max_rejected_frames", "consistency_window",
+  cfg.check_keys("input", {"imu", "features", "ground_truth", "source_reset_after", "max_gyro_radps",
+                           "max_accel_mps2", "max_normalized", "max_pixels_outside", "max_imu_gap_s", "max_rejected_frames", "consistency_window",
                            "consistency_min_tests", "max_chi2_failure_fraction", "max_quat_norm_error"});
   const int reset_after = cfg.get_or<int>("input.source_reset_after", o.imu.reset_after);
   const std::pair<const char*, StreamGuardOptions*> streams[] = {
-      {"imu", &o.imu}, {"features", &o.features}};
+      {"imu", &o.imu}, {"features", &o.features}, {"ground_truth", &o.ground_truth}};
   for (const auto& [name, s] : streams) {
     const std::string k = std::string("input.") + name;
-    cfg.check_keys(k, {"rate_hz", "max_forward_jump_s", "max_backward_jump_s"});
+    cfg.check_keys(k, {"rate_hz", "max_forward_jump_s", "max_backward_jump_s", "max_outage_s"});
     const double rate = cfg.get_or<double>(k + ".rate_hz", 0.0);
     if (!(rate >= 0.0) || !std::isfinite(rate)) cfg.fail(k + ".rate_hz", "must be finite and >= 0");
     s->expected_period_s = rate > 0.0 ? 1.0 / rate : 0.0;
     s->max_forward_jump_s = cfg.get_or<double>(k + ".max_forward_jump_s", s->max_forward_jump_s);
     s->max_backward_jump_s = cfg.get_or<double>(k + ".max_backward_jump_s", s->max_backward_jump_s);
+    s->max_outage_s = cfg.get_or<double>(k + ".max_outage_s", s->max_outage_s);
     s->reset_after = reset_after;
   }
   o.max_gyro_radps = cfg.get_or<double>("input.max_gyro_radps", o.max_gyro_radps);
   o.max_accel_mps2 = cfg.get_or<double>("input.max_accel_mps2", o.max_accel_mps2);
+  o.max_normalized = cfg.get_or<double>("input.max_normalized", o.max_normalized);
+  o.max_pixels_outside = cfg.get_or<double>("input.max_pixels_outside", o.max_pixels_outside);
   o.max_imu_gap_s = cfg.get_or<double>("input.max_imu_gap_s", o.max_imu_gap_s);
   o.max_rejected_frames = cfg.get_or<int>("input.max_rejected_frames", o.max_rejected_frames);
   o.consistency_window = cfg.get_or<int>("input.consistency_window", o.consistency_window);
@@ -94,7 +99,8 @@ VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, Event
       on_state_(std::move(on_state)),
       on_event_(std::move(on_event)),
       imu_guard_("IMU", options.input.imu),
-      frame_guard_("FEATURES", options.input.features) {
+      frame_guard_("FEATURES", options.input.features),
+      truth_guard_("GROUND_TRUTH", options.input.ground_truth) {
   options_.input.validate();
 }
 
@@ -126,7 +132,7 @@ void VinsNode::reset_estimate(const std::string& why, bool clean_clock) {
     estimator_.clear_imu();
     queued_frames_.clear();
     last_frame_utime_ = -1;
-    for (StreamGuard* g : {&imu_guard_, &frame_guard_}) g->reset();
+    for (StreamGuard* g : {&imu_guard_, &frame_guard_, &truth_guard_}) g->reset();
   }
   say(NodeEvent::Kind::kError, why + "; reset, re-initialising " +
                                    (options_.init_from_ground_truth ? "from ground truth" : "at rest"));
@@ -136,12 +142,17 @@ bool VinsNode::admit(StreamGuard& guard, int64_t utime) {
   const StreamCheck c = guard.check(utime);
   switch (c.verdict) {
     case StreamVerdict::kAccept:
-      if (c.lost > 0 && on_event_) on_event_(NodeEvent{NodeEvent::Kind::kLost, c.message, c.lost});
+      if (c.lost > 0 && on_event_) on_event_(NodeEvent{NodeEvent::Kind::kLost, c.message, c.lost, guard.name()});
       return true;
     case StreamVerdict::kRejectJump:
       say(NodeEvent::Kind::kDropped, c.message);
       return false;
     case StreamVerdict::kSourceReset:
+      if (c.lost > 0 && on_event_) on_event_(NodeEvent{NodeEvent::Kind::kLost, c.message, c.lost, guard.name()});
+      if (&guard == &truth_guard_) {
+        say(NodeEvent::Kind::kInfo, c.message);  // not an input of the estimate: only its clock restarts
+        return true;
+      }
       reset_estimate(c.message, /*clean_clock=*/true);
       guard.check(utime);  // the new clock starts here
       return true;
@@ -154,6 +165,9 @@ void VinsNode::on_imu(const ImuData& imu) {
 }
 
 void VinsNode::on_imu_checked(const ImuData& imu) {
+  // The clock first: a sample rejected for its values still took its slot
+  // in the stream (counted once, as dropped, not again as lost).
+  if (!admit(imu_guard_, imu.utime)) return;
   if (imu.w_IinI.allFinite() && imu.a_IinI.allFinite() &&
       (imu.w_IinI.norm() > options_.input.max_gyro_radps || imu.a_IinI.norm() > options_.input.max_accel_mps2)) {
     std::ostringstream msg;
@@ -163,7 +177,6 @@ void VinsNode::on_imu_checked(const ImuData& imu) {
     say(NodeEvent::Kind::kDropped, msg.str());
     return;
   }
-  if (!admit(imu_guard_, imu.utime)) return;
   const estimator::ImuFeedStatus status = estimator_.feed_imu(imu);
   switch (status) {
     case estimator::ImuFeedStatus::kAccepted:
@@ -186,6 +199,11 @@ void VinsNode::on_frame(const CameraFrame& frame) {
 
 void VinsNode::on_frame_checked(const CameraFrame& frame) {
   if (!admit(frame_guard_, frame.utime)) return;
+  const std::string absurd = absurd_observation(frame);
+  if (!absurd.empty()) {
+    say(NodeEvent::Kind::kDropped, "camera frame at utime " + std::to_string(frame.utime) + ": " + absurd);
+    return;
+  }
   if (frame.utime <= last_frame_utime_) {
     say(NodeEvent::Kind::kDropped, "camera frame at utime " + std::to_string(frame.utime) +
                                        (frame.utime == last_frame_utime_ ? " is a duplicate" : " is out of order"));
@@ -227,23 +245,58 @@ bool VinsNode::check_ground_truth(GroundTruth* truth) {
   return ok;
 }
 
-void VinsNode::on_ground_truth(const GroundTruth& message) {
+std::string VinsNode::absurd_observation(const CameraFrame& frame) const {
+  const std::vector<CameraCalibration>& cams = options_.vio.cameras;
+  const double max_n = options_.input.max_normalized;
+  const double margin = options_.input.max_pixels_outside;
+  for (const FeatureObservation& o : frame.observations) {
+    std::ostringstream why;
+    why << "feature " << o.feature_id << " ";
+    if (o.camera_id < 0 || o.camera_id >= static_cast<int>(cams.size())) {
+      why << "of camera " << o.camera_id << " (" << cams.size() << " calibrated)";
+      return why.str();
+    }
+    if (!(std::abs(o.normalized.x()) <= max_n && std::abs(o.normalized.y()) <= max_n)) {
+      why << "at normalized (" << o.normalized.x() << ", " << o.normalized.y() << "), beyond +-" << max_n;
+      return why.str();
+    }
+    const CameraCalibration& c = cams[static_cast<std::size_t>(o.camera_id)];
+    if (c.width > 0 && c.height > 0 &&
+        !(o.pixel.x() >= -margin && o.pixel.x() <= c.width + margin && o.pixel.y() >= -margin &&
+          o.pixel.y() <= c.height + margin)) {
+      why << "at pixel (" << o.pixel.x() << ", " << o.pixel.y() << "), more than " << margin << " px outside the "
+          << c.width << "x" << c.height << " image of camera " << o.camera_id;
+      return why.str();
+    }
+  }
+  return {};
+}
+
+bool VinsNode::on_ground_truth(const GroundTruth& message, GroundTruth* accepted) {
+  bool usable = false;
   guarded("on_ground_truth", [&] {
     GroundTruth truth = message;
-    if (!check_ground_truth(&truth)) return;
-    if (!options_.init_from_ground_truth || estimator_.initialized()) return;
+    const bool starting = options_.init_from_ground_truth && !estimator_.initialized();
     // A start far from the IMU's clock (a future or stale ground truth)
     // would make every frame "before the state time": wait for a good one.
-    // Checked before the stream's own clock, so such a message never sets it.
+    // Such a message never starts the stream's clock (it fills its slot in
+    // a running one, so it is not counted again as lost).
     const int64_t imu_utime = estimator_.propagator().latest_utime();
-    if (imu_utime >= 0 && std::abs(1e-6 * static_cast<double>(truth.utime - imu_utime)) > options_.input.max_imu_gap_s) {
-      say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth.utime) +
-                                         " is too far from the IMU clock (" + std::to_string(imu_utime) +
-                                         ") to initialise from");
+    if (starting && imu_utime >= 0 &&
+        std::abs(1e-6 * static_cast<double>(truth.utime - imu_utime)) > options_.input.max_imu_gap_s) {
+      if (!truth_guard_.started() || admit(truth_guard_, truth.utime)) {
+        say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth.utime) +
+                                           " is too far from the IMU clock (" + std::to_string(imu_utime) +
+                                           ") to initialise from");
+      }
       return;
     }
-    initialise_from(truth);
+    if (!admit(truth_guard_, truth.utime) || !check_ground_truth(&truth)) return;
+    usable = true;
+    if (accepted != nullptr) *accepted = truth;
+    if (starting) initialise_from(truth);
   });
+  return usable;
 }
 
 void VinsNode::initialise_from(const GroundTruth& truth) {

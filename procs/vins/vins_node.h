@@ -36,8 +36,18 @@ namespace vimot {
 struct InputGuardOptions {
   StreamGuardOptions imu{0.0, 0.5, 0.5, 3};
   StreamGuardOptions features{0.0, 2.0, 0.5, 3};
+  /// Ground truth (simulation): loss counting and jump rejection; a moved
+  /// clock here only restarts this stream's clock (it does not feed the estimate).
+  StreamGuardOptions ground_truth{0.0, 0.5, 0.5, 3};
   double max_gyro_radps{35.0};   // |ω| above: rejected (2000 °/s, a MEMS gyro's full scale)
   double max_accel_mps2{160.0};  // |a| above: rejected (16 g)
+  /// A camera frame with an observation of an unknown camera, an undistorted
+  /// coordinate |x| or |y| above `max_normalized` (a ray more than 84° off
+  /// the axis at 10), or a pixel more than `max_pixels_outside` outside its
+  /// camera's image (when the calibration gives a resolution) is corrupt:
+  /// the whole frame is rejected.
+  double max_normalized{10.0};
+  double max_pixels_outside{100.0};
   /// A frame more than this after the newest IMU sample (IMU lost while
   /// frames continue), or propagated across a longer IMU gap: reset. Also
   /// how close to the IMU clock a ground truth must be to start from.
@@ -100,7 +110,9 @@ class VinsNode {
 
   void on_imu(const ImuData& imu);
   void on_frame(const CameraFrame& frame);
-  void on_ground_truth(const GroundTruth& truth);
+  /// True if the message was usable (*accepted: it with unit quaternions);
+  /// false, said as dropped, if not.
+  bool on_ground_truth(const GroundTruth& truth, GroundTruth* accepted = nullptr);
   /// Processes every queued frame with the IMU data there is.
   void flush();
 
@@ -112,9 +124,12 @@ class VinsNode {
   bool initialized() const { return estimator_.initialized(); }
   int64_t frames_processed() const { return estimator_.frames_processed(); }
   int64_t resets() const { return resets_; }
-  /// Validates a ground-truth message in place (quaternions normalised);
-  /// false, said as dropped, if it is unusable.
+  /// Validates a ground-truth message's values in place (quaternions
+  /// normalised); false, said as dropped, if it is unusable.
   bool check_ground_truth(GroundTruth* truth);
+  /// Empty if every observation of `frame` is possible for the calibrated
+  /// cameras, else why not (input.max_normalized, max_pixels_outside).
+  std::string absurd_observation(const CameraFrame& frame) const;
   const estimator::VioEstimator& estimator() const { return estimator_; }
   /// For attaching an estimator extension (VioEstimator::set_extension).
   estimator::VioEstimator& mutable_estimator() { return estimator_; }
@@ -150,6 +165,7 @@ class VinsNode {
   int64_t resets_{0};
   StreamGuard imu_guard_;
   StreamGuard frame_guard_;
+  StreamGuard truth_guard_;
   int rejected_frames_{0};
   int64_t imu_rate_count_{0};
   struct GateCounts {

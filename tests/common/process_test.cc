@@ -83,21 +83,28 @@ TEST_CASE("heartbeat carries name and counters") {
   CHECK(got.messages_out == 0);  // the heartbeat itself is not counted
   // Input not used as it came makes the output suspect (heartbeat_t.lcm).
   CHECK(got.status == "degraded");
-  CHECK(got.counter_names == std::vector<std::string>({"bytes_dropped", "reconnects"}));
-  CHECK(got.counter_values == std::vector<int64_t>({7, 1}));
+  // The scaffold's own first: messages received per subscribed channel
+  // (the first heartbeat), then the process's.
+  CHECK(got.counter_names == std::vector<std::string>({"in HEARTBEAT", "bytes_dropped", "reconnects"}));
+  CHECK(got.counter_values == std::vector<int64_t>({1, 7, 1}));
 }
 
 TEST_CASE("input lost on the way is counted with the dropped and degrades the status") {
   auto p = make_process();
   vimot::heartbeat_t got{};
   p->subscribe<vimot::heartbeat_t>("HEARTBEAT", [&](const vimot::heartbeat_t& hb) { got = hb; });
-  p->report_lost(3, "3 IMU messages lost");
+  p->report_lost(3, "3 IMU messages lost", "IMU");
+  p->report_lost(1, "1 FEATURES message lost", "FEATURES");
+  p->report_lost(2, "2 IMU messages lost", "IMU");
   p->publish_heartbeat();
   while (p->lcm().handleTimeout(10) > 0) {
   }
-  CHECK(p->counters().lost == 3);
-  CHECK(got.dropped == 3);
+  CHECK(p->counters().lost == 6);
+  CHECK(got.dropped == 6);
   CHECK(got.status == "degraded");
+  // Per stream, in the order first lost.
+  CHECK(got.counter_names == std::vector<std::string>({"in HEARTBEAT", "lost IMU", "lost FEATURES"}));
+  CHECK(got.counter_values == std::vector<int64_t>({0, 5, 1}));
 }
 
 TEST_CASE("channels come from config; a missing required config is an error") {

@@ -188,6 +188,7 @@ TEST_CASE("absurd IMU values are rejected and counted, then an IMU pause flushes
     return true;
   }));
   CHECK(gyro.dropped == 1);
+  CHECK(gyro.lost == 0);  // the sample arrived: counted once, as dropped
   check_absorbed(gyro);
 
   done = false;
@@ -197,6 +198,7 @@ TEST_CASE("absurd IMU values are rejected and counted, then an IMU pause flushes
     return true;
   }));
   CHECK(accel.dropped == 1);
+  CHECK(accel.lost == 0);
   check_absorbed(accel);
 
   // The idle path of the process: IMU paused, flush() with frames queued.
@@ -223,6 +225,7 @@ TEST_CASE("one future IMU sample is dropped, the stream goes on", "[fault]") {
     return true;
   }));
   CHECK(run.dropped == 1);
+  CHECK(run.lost == 0);  // its slot in the stream is not counted again as lost
   check_absorbed(run);
 }
 
@@ -234,7 +237,55 @@ TEST_CASE("one future camera frame is dropped, the stream goes on", "[fault]") {
     return true;
   }));
   CHECK(run.dropped == 1);
+  CHECK(run.lost == 0);
   check_absorbed(run);
+}
+
+TEST_CASE("finite but absurd feature coordinates reject their frame, counted once, absorbed", "[fault]") {
+  // One corrupt observation per faulty frame: normalized 1e30, a pixel far
+  // outside the 752x480 image, a camera that does not exist.
+  const std::vector<std::function<void(FeatureObservation&)>> corruptions = {
+      [](FeatureObservation& o) { o.normalized.x() = 1e30; },
+      [](FeatureObservation& o) { o.normalized.y() = -50.0; },
+      [](FeatureObservation& o) { o.pixel = Eigen::Vector2d(1e6, 100.0); },
+      [](FeatureObservation& o) { o.pixel.y() = -1e30; },
+      [](FeatureObservation& o) { o.camera_id = 7; },
+  };
+  std::size_t next = 0;
+  std::vector<int64_t> corrupted;
+  const Run run = run_vins(inject([&](Timed& te) {
+    auto* frame = std::get_if<CameraFrame>(&te.event);
+    // Every other frame from the fault on, until each corruption was used.
+    if (frame && next < corruptions.size() && (te.sim_utime / 100'000) % 2 == 0) {
+      REQUIRE(!frame->observations.empty());
+      corruptions[next++](frame->observations[frame->observations.size() / 2]);
+      corrupted.push_back(frame->utime);
+    }
+    return true;
+  }));
+  REQUIRE(corrupted.size() == corruptions.size());
+  CHECK(run.dropped == static_cast<int64_t>(corruptions.size()));
+  CHECK(run.lost == 0);
+  int said_frames = 0;
+  for (const NodeEvent& e : run.events) {
+    for (int64_t t : corrupted) {
+      said_frames += e.kind == NodeEvent::Kind::kDropped &&
+                     e.message.find("camera frame at utime " + std::to_string(t)) != std::string::npos;
+    }
+  }
+  CHECK(said_frames == static_cast<int>(corruptions.size()));
+  check_absorbed(run, kFault + 1'000'000 + kSettle);
+
+  // Limits off (very large): the same frames pass, as every clean one does.
+  VinsNodeOptions lax = vins_options();
+  lax.input.max_normalized = 1e31;
+  lax.input.max_pixels_outside = 1e31;
+  VinsNode node(lax, {}, {});
+  CameraFrame frame;
+  frame.observations.resize(1);
+  frame.observations[0].normalized.x() = 1e30;
+  CHECK(node.absurd_observation(frame).empty());
+  CHECK(VinsNode(vins_options(), {}, {}).absurd_observation(frame).find("normalized") != std::string::npos);
 }
 
 TEST_CASE("a future first ground truth does not block the output", "[fault]") {
@@ -291,7 +342,7 @@ TEST_CASE("all input lost for 1 s (a stalled process) is counted, then reset or 
 }
 
 TEST_CASE("lost messages are counted exactly against the expected rate", "[fault]") {
-  int removed_imu = 0, removed_frames = 0, n = 0;
+  int removed_imu = 0, removed_frames = 0, removed_truths = 0, n = 0;
   const Run run = run_vins(inject([&](Timed& te) {
     ++n;
     if (te.sim_utime > kDuration * 1e6 - 1'000'000) return true;  // a loss at the very end cannot be seen
@@ -301,11 +352,13 @@ TEST_CASE("lost messages are counted exactly against the expected rate", "[fault
     if (std::holds_alternative<CameraFrame>(te.event) && (te.sim_utime / 100000) % 5 == 0) {
       return ++removed_frames, false;
     }
+    if (std::holds_alternative<GroundTruth>(te.event) && n % 11 == 0) return ++removed_truths, false;
     return true;
   }));
   REQUIRE(removed_imu > 50);
   REQUIRE(removed_frames > 5);
-  CHECK(run.lost == removed_imu + removed_frames);
+  REQUIRE(removed_truths > 50);
+  CHECK(run.lost == removed_imu + removed_frames + removed_truths);
   CHECK(run.resets == 0);
   CHECK(run.rms_from(kFault + kSettle) < 0.1);
 }
