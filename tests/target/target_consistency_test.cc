@@ -7,7 +7,7 @@
 // band is asked for; so does the target's orientation in the world. The
 // target's position in the world is the robot's position plus the target in
 // the IMU: its NEES follows the robot's (VIO's) own, which reads low on
-// these short runs (≈ 1.5–1.9), so it is reported, not checked. The target is the
+// these short runs (≈ 1.9), so it is reported, not checked. The target is the
 // paper's constant-speed semicircle, so every σ_t there is a right model.
 // The filter before issue 15 (no observability constraint, gauge prior
 // 0.01) fails it: run with env TARGET_CONFIG=<a copy of the config with
