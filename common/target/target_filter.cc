@@ -208,6 +208,15 @@ bool TargetFilter::propagate_jointly(const State& state, const estimator::ImuVal
     step.Phi_TI = lin.Phi_TI;
     step.Q_TT = lin.Q_TT;
     step.Q_TI = lin.Q_TI;
+    // The next first estimate is the propagated current estimate, not the
+    // propagated first estimate: without the constraint Φ maps the gauge onto
+    // the wrong directions by the last update of v, w and the pose, and the
+    // target frame gains information its points do not give.
+    if (options_.observability_constraint) {
+      constrain_observability(
+          joint_unobservable_directions(options_.representation, state.imu()->get_fej(), target_->get_fej()),
+          joint_unobservable_directions(options_.representation, x1, step.x), &step);
+    }
   }
   Eigen::Matrix<double, 27, 27> F, Qd;
   joint_transition(Phi_II, Q_II, step, &F, &Qd);

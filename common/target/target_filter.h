@@ -154,6 +154,11 @@ struct TargetFilterOptions {
   uint64_t init_perturb_seed{0};
   double chi2_multiplier{1.0};
   int min_clone_times{2};
+  /// With the estimator's FEJ: constrain the target rows of the joint
+  /// transition so that it maps the unobservable directions (target gauge,
+  /// world yaw and position) at one first estimate onto those at the next
+  /// (target::constrain_observability; docs/target_model.md).
+  bool observability_constraint{true};
   // Target points in the state (0 disables them: MSCKF-only target updates).
   int max_target_points{25};
   int point_init_clone_times{3};

@@ -51,7 +51,7 @@ TargetSection target_section_from_config(const Config& config) {
   if (!config.has("target")) return t;
   const Config c = config.sub("target");
   config.check_keys("target", {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times",
-                               "init", "init_sigmas", "points", "prediction_horizon_s"});
+                               "observability_constraint", "init", "init_sigmas", "points", "prediction_horizon_s"});
   TargetFilterOptions& o = t.filter;
   if (c.has("mode")) {
     const std::string mode = c.get<std::string>("mode");
@@ -74,6 +74,7 @@ TargetSection target_section_from_config(const Config& config) {
   o.planar = c.get_or<bool>("planar", o.planar);
   o.chi2_multiplier = positive(c, "chi2_multiplier", o.chi2_multiplier);
   o.min_clone_times = at_least(c, "min_clone_times", o.min_clone_times, 2);
+  o.observability_constraint = c.get_or<bool>("observability_constraint", o.observability_constraint);
   if (c.has("init")) {
     c.check_keys("init", {"mode", "frames", "min_points", "max_point_distance", "sigma_w"});
     const Config i = c.sub("init");

@@ -6,7 +6,7 @@
 //     mode: skf | ekf | off | none   (none: no filter attached, the process
 //                                     runs pure VIO; the evaluator refuses it)
 //     representation: local | global
-//     sigma_t, planar, chi2_multiplier, min_clone_times,
+//     sigma_t, planar, chi2_multiplier, min_clone_times, observability_constraint,
 //     init: {mode: features | ground_truth, frames, min_points,
 //            max_point_distance, sigma_w}   (docs/target_model.md),
 //     init_sigmas: {theta, p, v, w},

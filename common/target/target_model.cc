@@ -232,6 +232,41 @@ void joint_transition(const Matrix15d& Phi_II, const Matrix15d& Q_II, const Targ
   }
 }
 
+JointNullspace joint_unobservable_directions(TargetRepresentation representation, const estimator::ImuValue& imu,
+                                             const TargetValue& x) {
+  JointNullspace N = JointNullspace::Zero();
+  const Eigen::Matrix3d R_RtoT = quat_to_rot(x.q_RtoT);
+  const Eigen::Vector3d e_z = Eigen::Vector3d::UnitZ();
+  // Target gauge (target rows start at 15).
+  N.block<3, 3>(15, 0) = Eigen::Matrix3d::Identity();
+  N.block<3, 3>(21, 0) = skew(x.v_TinT);
+  N.block<3, 3>(24, 0) = skew(x.w_TinT);
+  N.block<3, 3>(18, 3) = R_RtoT.transpose();
+  N.block<3, 3>(21, 3) = skew(x.w_TinT);
+  // World yaw and position.
+  N.block<3, 1>(0, 6) = quat_to_rot(imu.q_GtoI) * e_z;
+  N.block<3, 1>(3, 6) = -skew(imu.p_IinG) * e_z;
+  N.block<3, 1>(6, 6) = -skew(imu.v_IinG) * e_z;
+  N.block<3, 3>(3, 7) = Eigen::Matrix3d::Identity();
+  if (representation == TargetRepresentation::kGlobal) {
+    N.block<3, 1>(15, 6) = R_RtoT * e_z;
+    N.block<3, 1>(18, 6) = -skew(x.p_TinR) * e_z;
+    N.block<3, 3>(18, 7) = Eigen::Matrix3d::Identity();
+  }
+  return N;
+}
+
+void constrain_observability(const JointNullspace& U, const JointNullspace& W, TargetStep* step) {
+  Eigen::Matrix<double, 12, 27> Phi_T;
+  Phi_T << step->Phi_TI, step->Phi_TT;
+  // U has full column rank (its IMU rows separate the world columns from the
+  // target ones), so U⁺ = (UᵀU)⁻¹Uᵀ.
+  const Eigen::Matrix<double, 10, 27> U_pinv = (U.transpose() * U).ldlt().solve(U.transpose());
+  Phi_T -= (Phi_T * U - W.bottomRows<12>()) * U_pinv;
+  step->Phi_TI = Phi_T.leftCols<15>();
+  step->Phi_TT = Phi_T.rightCols<12>();
+}
+
 // ---------------------------------------------------------------------------
 // Prediction
 

@@ -130,6 +130,31 @@ TargetStep propagate_target_imu_step(TargetRepresentation representation, const 
 void joint_transition(const Matrix15d& Phi_II, const Matrix15d& Q_II, const TargetStep& step,
                       Eigen::Matrix<double, 27, 27>* Phi, Eigen::Matrix<double, 27, 27>* Q);
 
+/// Unobservable directions of the joint [δx_I (15); δx_T (12)] at (imu, x)
+/// (docs/target_model.md, "Observability constraint"), 27×10:
+///   0–2  the target gauge, T rotated on its body by α (in T):
+///        target rows [α; 0; [v×]α; [w×]α] (its points −t + [p_FinT×]α with
+///        t = 0, its clones the pose rows);
+///   3–5  the target gauge, T's origin moved on its body by t (in T):
+///        target rows [0; R_RtoTᵀ t; [w×]t; 0] (points −t);
+///   6    the world yaw: IMU rows [R_GtoI e_z; −[p_IinG×]e_z; −[v_IinG×]e_z; 0; 0]
+///        (the estimator's FEJ nullspace, propagator.h), global target rows
+///        [R_GtoT e_z; −[p_TinG×]e_z; 0; 0], local target rows 0;
+///   7–9  the world position: IMU rows [0; I; 0; 0; 0], global target [0; I; 0; 0],
+///        local target 0.
+/// The IMU rows of columns 0–5 are zero: the target gauge does not move the robot.
+using JointNullspace = Eigen::Matrix<double, 27, 10>;
+JointNullspace joint_unobservable_directions(TargetRepresentation representation, const estimator::ImuValue& imu,
+                                             const TargetValue& x);
+
+/// Observability constraint (OC-EKF, Huang, Mourikis, Roumeliotis): the
+/// smallest (Frobenius) change of the target rows [Φ_TI Φ_TT] of the joint
+/// transition that maps U, the unobservable directions at t_k's linearisation
+/// point, exactly onto W, those at t_k+1's:
+///   [Φ_TI Φ_TT] ← [Φ_TI Φ_TT] − ([Φ_TI Φ_TT] U − W_T) U⁺   (W_T: target rows of W).
+/// The IMU rows are the estimator's (its FEJ already maps them).
+void constrain_observability(const JointNullspace& U, const JointNullspace& W, TargetStep* step);
+
 // ---------------------------------------------------------------------------
 // Prediction of the target alone (no measurements)
 

@@ -6,6 +6,7 @@
 #include "common/estimator/propagator.h"
 #include "common/math/quat.h"
 #include "common/target/target_conversion.h"
+#include "common/target/target_measurement.h"
 #include "common/target/target_model.h"
 #include "target_test_util.h"
 
@@ -342,4 +343,143 @@ TEST_CASE("prediction: one long step equals chained steps; local prediction goes
   CHECK(boxminus(pl.x, pg.x).norm() < 1e-10);
   CHECK(rel_err(pl.P, pg.P) < 1e-12);
   CHECK_THROWS_AS(predict_global(x, P0, -1.0, tn), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------
+// Unobservable directions and the observability constraint
+namespace {
+
+// The target gauge applied by definition: T' on the same body, rotated by
+// R_TtoT' = Exp(−α) and with its origin at t (in T). Points p' = R_TtoT'(p − t).
+TargetValue gauge_target(const TargetValue& x, const Eigen::Vector3d& alpha, const Eigen::Vector3d& t) {
+  const Eigen::Matrix3d R_TtoTp = exp_so3(-alpha);
+  TargetValue y = x;
+  y.q_RtoT = rot_to_quat(R_TtoTp * x.R_RtoT());
+  y.p_TinR = x.p_TinR + x.R_RtoT().transpose() * t;
+  y.v_TinT = R_TtoTp * (x.v_TinT + x.w_TinT.cross(t));
+  y.w_TinT = R_TtoTp * x.w_TinT;
+  return y;
+}
+
+// The world moved: rotated by φ about z and shifted by d (G' ← G).
+ImuValue gauge_world(const ImuValue& imu, double phi, const Eigen::Vector3d& d) {
+  const Eigen::Matrix3d Rz = exp_so3(phi * Eigen::Vector3d::UnitZ());
+  ImuValue y = imu;
+  y.q_GtoI = rot_to_quat(quat_to_rot(imu.q_GtoI) * Rz.transpose());
+  y.p_IinG = Rz * imu.p_IinG + d;
+  y.v_IinG = Rz * imu.v_IinG;
+  return y;
+}
+TargetValue gauge_world(const TargetValue& x, double phi, const Eigen::Vector3d& d) {
+  const Eigen::Matrix3d Rz = exp_so3(phi * Eigen::Vector3d::UnitZ());
+  TargetValue y = x;
+  y.q_RtoT = rot_to_quat(x.R_RtoT() * Rz.transpose());
+  y.p_TinR = Rz * x.p_TinR + d;
+  return y;
+}
+
+}  // namespace
+
+TEST_CASE("unobservable directions: the gauge transformations' derivatives, kept by the exact step, "
+          "annihilated by the point Jacobians", "[target]") {
+  const ImuValue imu = test::sample_imu();
+  const TargetValue x = test::sample_target();
+  for (TargetRepresentation rep : {TargetRepresentation::kLocal, TargetRepresentation::kGlobal}) {
+    const bool global = rep == TargetRepresentation::kGlobal;
+    INFO((global ? "global" : "local"));
+    const JointNullspace N = joint_unobservable_directions(rep, imu, x);
+    // Columns against finite differences of the transformations themselves.
+    const Eigen::MatrixXd Ng = central_diff(6, [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
+      Eigen::VectorXd e(27);
+      e << Eigen::Matrix<double, 15, 1>::Zero(), boxminus(gauge_target(x, d.head<3>(), d.tail<3>()), x);
+      return e;
+    });
+    const Eigen::MatrixXd Nw = central_diff(4, [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
+      Eigen::VectorXd e(27);
+      const TargetValue xw = global ? gauge_world(x, d(0), d.tail<3>()) : x;
+      e << boxminus(gauge_world(imu, d(0), d.tail<3>()), imu), boxminus(xw, x);
+      return e;
+    });
+    CHECK(rel_err(N.leftCols<6>(), Ng) < 1e-8);
+    CHECK(rel_err(N.rightCols<4>(), Nw) < 1e-8);
+
+    // The exact joint step (IMU linearised at its estimate) maps them onto themselves.
+    const Eigen::Vector3d w_m = imu.bg + Eigen::Vector3d(0.4, -0.7, 1.1);
+    const Eigen::Vector3d a_m(0.7, -0.4, 9.9);
+    ImuValue imu1;
+    Matrix15d Phi_II, Q_II;
+    const TargetStep s = propagate_target_imu_step(rep, x, imu, imu, w_m, a_m, 0.1, kGravity, ImuNoise{},
+                                                   sample_noise(), &imu1, &Phi_II, &Q_II);
+    Eigen::Matrix<double, 27, 27> Phi, Q;
+    joint_transition(Phi_II, Q_II, s, &Phi, &Q);
+    const JointNullspace N1 = joint_unobservable_directions(rep, imu1, s.x);
+    CHECK(rel_err(Phi * N, N1) < 1e-9);
+
+    // A target point's measurement does not see them: target pose, point
+    // (gauge rows [p_FinT×]α − t, world rows 0) and, global, the IMU pose.
+    const Eigen::Vector3d p_FinT(0.3, -0.2, 0.4);
+    CameraExtrinsics cam;
+    cam.R_ItoC = exp_so3(Eigen::Vector3d(0.1, 1.4, -0.2));
+    cam.p_IinC = Eigen::Vector3d(0.05, -0.02, 0.01);
+    const TargetPointPrediction pred = predict_target_point(rep, PoseValue{imu.q_GtoI, imu.p_IinG},
+                                                            PoseValue{x.q_RtoT, x.p_TinR}, p_FinT, cam, -1e9);
+    Eigen::Matrix<double, 3, 10> N_point = Eigen::Matrix<double, 3, 10>::Zero();
+    N_point.leftCols<3>() = skew(p_FinT);
+    N_point.middleCols<3>(3) = -Eigen::Matrix3d::Identity();
+    const Eigen::Matrix<double, 2, 10> HN =
+        pred.H_imu_pose * N.topRows<6>() + pred.H_target_pose * N.middleRows<6>(15) + pred.H_point * N_point;
+    CHECK(HN.cwiseAbs().maxCoeff() < 1e-12 * std::max(1.0, pred.H_target_pose.cwiseAbs().maxCoeff()));
+  }
+}
+
+TEST_CASE("observability constraint: the first-estimate step maps the directions onto the next first "
+          "estimate's, with a change of the size of the mismatch", "[target]") {
+  const ImuValue imu = test::sample_imu();
+  const TargetValue x = test::sample_target();
+  // First estimates that differ from the (updated) estimates, as after an update.
+  ImuValue imu_lin = imu;
+  imu_lin.q_GtoI = quat_boxplus(imu.q_GtoI, Eigen::Vector3d(0.002, -0.001, 0.003));
+  imu_lin.p_IinG += Eigen::Vector3d(0.01, 0.02, -0.01);
+  imu_lin.v_IinG += Eigen::Vector3d(-0.005, 0.002, 0.004);
+  Vector12d dx;
+  dx << 0.003, -0.002, 0.001, 0.01, -0.02, 0.015, 0.05, -0.03, 0.02, 0.02, -0.01, 0.03;
+  const TargetValue x_lin = boxplus(x, dx);
+  const Eigen::Vector3d w_m = imu.bg + Eigen::Vector3d(0.4, -0.7, 1.1);
+  const Eigen::Vector3d a_m(0.7, -0.4, 9.9);
+  for (TargetRepresentation rep : {TargetRepresentation::kLocal, TargetRepresentation::kGlobal}) {
+    INFO((rep == TargetRepresentation::kGlobal ? "global" : "local"));
+    // The filter's step: mean from the estimates, Φ at the first estimates.
+    ImuValue imu1;
+    Matrix15d Phi_II, Q_II;
+    const TargetStep mean = propagate_target_imu_step(rep, x, imu, imu_lin, w_m, a_m, 0.1, kGravity, ImuNoise{},
+                                                      sample_noise(), &imu1, &Phi_II, &Q_II);
+    TargetStep lin = propagate_target(rep, x_lin, imu_lin, imu1, Phi_II, Q_II, 0.1, sample_noise());
+    const JointNullspace U = joint_unobservable_directions(rep, imu_lin, x_lin);
+    const JointNullspace W = joint_unobservable_directions(rep, imu1, mean.x);
+    Eigen::Matrix<double, 27, 27> Phi;
+    joint_transition(Phi_II, Q_II, lin, &Phi, nullptr);
+    const double before = (Phi * U - W).bottomRows<12>().cwiseAbs().maxCoeff();
+    const TargetStep unconstrained = lin;
+    constrain_observability(U, W, &lin);
+    joint_transition(Phi_II, Q_II, lin, &Phi, nullptr);
+    const double after = (Phi * U - W).bottomRows<12>().cwiseAbs().maxCoeff();
+    Eigen::Matrix<double, 12, 27> change;
+    change << lin.Phi_TI - unconstrained.Phi_TI, lin.Phi_TT - unconstrained.Phi_TT;
+    INFO("mismatch before " << before << " after " << after << " largest change of Φ " << change.cwiseAbs().maxCoeff());
+    CHECK(before > 1e-3);  // the unconstrained first-estimate step leaks
+    CHECK(after < 1e-12);
+    // The smallest change: its rows lie in the span of U's columns.
+    const Eigen::Matrix<double, 27, 27> P_U = U * (U.transpose() * U).inverse() * U.transpose();
+    CHECK((change - change * P_U).cwiseAbs().maxCoeff() < 1e-12);
+
+    // Already consistent (first estimates = estimates): nothing changes.
+    ImuValue imu1e;
+    TargetStep exact = propagate_target_imu_step(rep, x, imu, imu, w_m, a_m, 0.1, kGravity, ImuNoise{},
+                                                 sample_noise(), &imu1e, &Phi_II, &Q_II);
+    const TargetStep exact0 = exact;
+    constrain_observability(joint_unobservable_directions(rep, imu, x),
+                            joint_unobservable_directions(rep, imu1e, exact.x), &exact);
+    CHECK((exact.Phi_TT - exact0.Phi_TT).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK((exact.Phi_TI - exact0.Phi_TI).cwiseAbs().maxCoeff() < 1e-10);
+  }
 }
