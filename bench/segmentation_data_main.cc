@@ -42,11 +42,4 @@ int run(int argc, const char* const* argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vimot-segmentation-data: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return vimot::run_main("vimot-segmentation-data", argc, argv, run); }

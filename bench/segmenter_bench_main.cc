@@ -87,11 +87,4 @@ int run(int argc, const char* const* argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vimot-bench-segmenter: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return vimot::run_main("vimot-bench-segmenter", argc, argv, run); }

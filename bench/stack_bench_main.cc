@@ -201,11 +201,4 @@ int run(int argc, const char* const* argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "vimot-bench-stack: " << e.what() << "\n";
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return vimot::run_main("vimot-bench-stack", argc, argv, run); }

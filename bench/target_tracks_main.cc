@@ -117,11 +117,4 @@ int run(int argc, const char* const* argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& ex) {
-    std::fprintf(stderr, "vimot-bench-target-tracks: %s\n", ex.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return vimot::run_main("vimot-bench-target-tracks", argc, argv, run); }

@@ -19,6 +19,15 @@ std::vector<std::string> split_comma_list(const std::string& list) {
   return out;
 }
 
+int run_main(const char* program, int argc, char** argv, int (*run)(int, const char* const*)) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << program << ": " << e.what() << "\n";
+    return 1;
+  }
+}
+
 ArgParser::ArgParser(std::string program, std::string summary)
     : program_(std::move(program)), summary_(std::move(summary)) {
   add_flag("help", "print this help and exit");

@@ -17,6 +17,10 @@ class ArgError : public std::runtime_error {
 /// The non-empty items of a comma-separated option value ("a,b,,c" -> a b c).
 std::vector<std::string> split_comma_list(const std::string& list);
 
+/// The body of a tool's main(): returns run(argc, argv); an exception that
+/// escapes it is reported as "<program>: <what>" on stderr with status 1.
+int run_main(const char* program, int argc, char** argv, int (*run)(int, const char* const*));
+
 class ArgParser {
  public:
   ArgParser(std::string program, std::string summary);
