@@ -194,3 +194,18 @@ TEST_CASE("a directory or an empty file as a process config says so", "[config]"
   CHECK(msg.find("is empty") != std::string::npos);
   CHECK(msg.find("cameras.cam0") == std::string::npos);
 }
+
+// The config loader has no include: the segmented chain's tracker configs
+// copy the true-box ones' tracker settings, and must not drift from them
+// (the figures of the two chains are compared).
+TEST_CASE("the segmented tracker configs track as the true-box ones") {
+  const auto tracker_section = [](const std::string& file) {
+    std::ifstream in(source_path("config/" + file));
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t at = text.find("\ntracker:\n");
+    REQUIRE(at != std::string::npos);
+    return text.substr(at);
+  };
+  CHECK(tracker_section("feature_tracker_segmented.yaml") == tracker_section("feature_tracker_sim.yaml"));
+  CHECK(tracker_section("feature_tracker_segmented_mono.yaml") == tracker_section("feature_tracker_sim_mono.yaml"));
+}
