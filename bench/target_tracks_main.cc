@@ -16,6 +16,7 @@
 #include "common/eval/pixel_frontend.h"
 #include "common/frontend/tracker_options.h"
 #include "common/object/object_tracker.h"
+#include "bench/rendered_scenario_args.h"
 #include "common/process/arg_parser.h"
 #include "common/sim/sim_config.h"
 
@@ -38,20 +39,13 @@ int run(int argc, const char* const* argv) {
                  "object tracker makes of them: box size, target features per frame, features common\n"
                  "with the frame --lag before (the initialisation's need), track lengths, tracker\n"
                  "valid frames and counters.");
-  args.add_option("sim", "FILE", "simulator config", "config/sim_mono.yaml");
-  args.add_option("tracker", "FILE", "feature tracker config (its tracker: section)",
-                  "config/feature_tracker_sim_mono.yaml");
+  add_rendered_scenario_options(args, "config/sim_mono.yaml", "config/feature_tracker_sim_mono.yaml", "20");
   args.add_option("object-tracker", "FILE", "object tracker config", "config/object_tracker.yaml");
-  args.add_option("seed", "N", "simulator seed", "1");
-  args.add_option("duration", "S", "seconds simulated", "20");
   args.add_option("lag", "N", "frames between the compared frames (object tracker init_frames - 1)", "39");
   if (!args.parse(argc, argv)) return 0;
-  cv::setNumThreads(1);
-  sim::SimConfig config = sim::from_config(Config::load_file(args.get("sim")));
-  config.seed = static_cast<uint64_t>(args.get_int("seed"));
-  config.duration = std::stod(args.get("duration"));
-  const sim::Simulator sim(config);
-  const auto options = frontend::FeatureTrackerOptions::from_config(Config::load_file(args.get("tracker")), "tracker");
+  const RenderedScenario scenario = rendered_scenario_from(args);
+  const sim::Simulator sim(scenario.sim);
+  const frontend::FeatureTrackerOptions& options = scenario.tracker;
   ObjectTracker object(object_tracker_options_from_config(Config::load_file(args.get("object-tracker"))));
   eval::PixelFrontEnd front(sim, options);
   const int lag = static_cast<int>(args.get_int("lag"));

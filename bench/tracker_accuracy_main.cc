@@ -14,6 +14,7 @@
 #include "common/config/config.h"
 #include "common/eval/tracker_accuracy.h"
 #include "common/frontend/tracker_options.h"
+#include "bench/rendered_scenario_args.h"
 #include "common/process/arg_parser.h"
 #include "common/sim/sim_config.h"
 
@@ -44,18 +45,11 @@ int run(int argc, const char* const* argv) {
                  "observation after a track's first against the true point (the first observation's ray\n"
                  "meeting the scene) projected through the true pose. Median, p95, fraction > 3 px and the\n"
                  "per-axis sigma of the errors <= 3 px, by camera, age, box distance and label.");
-  args.add_option("sim", "FILE", "simulator config", "config/sim_paper.yaml");
-  args.add_option("tracker", "FILE", "feature tracker config (its tracker: section)",
-                  "config/feature_tracker_sim.yaml");
-  args.add_option("seed", "N", "simulator seed", "1");
-  args.add_option("duration", "S", "seconds simulated", "30");
+  add_rendered_scenario_options(args, "config/sim_paper.yaml", "config/feature_tracker_sim.yaml", "30");
   if (!args.parse(argc, argv)) return 0;
-  cv::setNumThreads(1);
-  sim::SimConfig config = sim::from_config(Config::load_file(args.get("sim")));
-  config.seed = static_cast<uint64_t>(args.get_int("seed"));
-  config.duration = std::stod(args.get("duration"));
-  const sim::Simulator sim(config);
-  const auto options = frontend::FeatureTrackerOptions::from_config(Config::load_file(args.get("tracker")), "tracker");
+  const RenderedScenario scenario = rendered_scenario_from(args);
+  const sim::Simulator sim(scenario.sim);
+  const frontend::FeatureTrackerOptions& options = scenario.tracker;
   eval::PixelFrontEnd front(sim, options);
   const std::vector<eval::ObservationError> e = eval::tracker_errors(sim, &front, sim.camera_frame_count());
 
