@@ -34,6 +34,7 @@
 #include "common/sim/renderer.h"
 #include "common/target/target_filter.h"
 #include "common/time/utime.h"
+#include "procs/eval/target_run.h"
 
 namespace {
 

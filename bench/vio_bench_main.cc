@@ -19,6 +19,7 @@
 #include "common/eval/sim_runner.h"
 #include "common/process/arg_parser.h"
 #include "common/sim/sim_config.h"
+#include "procs/eval/vio_run.h"
 
 namespace {
 

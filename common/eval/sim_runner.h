@@ -1,18 +1,17 @@
 #pragma once
-// The estimator on the simulator, end to end, without LCM: what the `vins`
-// process does with the simulator's messages, run offline and as fast as
-// the CPU allows, plus the evaluation against the simulator's truth.
+// The estimator on the simulator, evaluated against the simulator's truth:
+// what a run and a Monte Carlo measure. The runs themselves drive the
+// `vins` process's Node fed the simulator's messages as over LCM
+// (procs/eval/vio_run.h, vimot-vio-eval), so this library holds only their
+// results and the parts that need no process.
 //
-// One run: build the Simulator (GroundTruth events forced on), start the
-// estimator from initial_estimate(sim.initial_state(), options,
-// perturb_seed) at the first utime, then feed every IMU sample
-// (feed_imu) and camera frame (feed_camera) in the simulator's order. The
-// evaluation samples are the states right after each processed camera
-// frame — nav_state_of(estimator, updated = true), exactly what the `vins`
-// process publishes on VINS_STATE with updated = true — each compared with
-// the GroundTruth event of the same utime (error_of, common/eval/metrics.h).
-// A frame the estimator does not process (diverged, no IMU) gives no sample;
-// a run stops at divergence and says so.
+// One run: the simulator (GroundTruth events on) plays into VinsNode, which
+// starts from the first ground truth perturbed by initial_estimate(...,
+// perturb_seed). The evaluation samples are the states the node publishes
+// after each processed camera frame (VINS_STATE, updated = true), each
+// compared with the GroundTruth of the same utime (error_of,
+// common/eval/metrics.h). A frame the estimator does not process (no IMU)
+// gives no sample; a reset of the node (divergence) ends the run, said so.
 //
 // Monte Carlo: run i uses simulator seed first_seed + i (new noise, same
 // truth and map) and perturbation seed perturb_seed_for_run(first_seed + i).
@@ -101,10 +100,6 @@ void play_simulator(sim::Simulator& sim, estimator::VioEstimator& estimator,
                     const std::function<void(const GroundTruth&)>& on_truth,
                     const std::function<bool(const CameraFrame&)>& on_frame, PixelFrontEnd* pixels = nullptr);
 
-/// One run on `sim_config` (its seed and duration as given).
-SimRunResult run_vio_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
-                            uint64_t perturb_seed, const SimRunOptions& run_options = {});
-
 struct MonteCarloOptions {
   int runs{30};
   uint64_t first_seed{1};
@@ -138,14 +133,6 @@ void run_parallel(int jobs, int threads, const std::function<void(int, const std
 
 /// Perturbation seed of run with simulator seed `sim_seed` under `o`.
 uint64_t perturb_seed_of(const MonteCarloOptions& o, uint64_t sim_seed);
-
-/// Runs o.runs independent runs on o.threads std::threads; results in run
-/// order. `progress` is called on the calling thread, about every 0.25 s
-/// and once at the end. The first exception of a run is rethrown after all
-/// threads are joined.
-std::vector<SimRunResult> run_monte_carlo(const sim::SimConfig& base, const estimator::VioOptions& options,
-                                          const MonteCarloOptions& o,
-                                          const std::function<void(const MonteCarloProgress&)>& progress = {});
 
 /// The per-run error summaries of a Monte Carlo, aggregated.
 MonteCarloSummary aggregate(const std::vector<SimRunResult>& runs);

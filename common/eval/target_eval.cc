@@ -1,32 +1,17 @@
 #include "common/eval/target_eval.h"
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <memory>
 #include <sstream>
 #include <stdexcept>
-#include <variant>
 
-#include "common/estimator/initial_estimate.h"
-#include "common/estimator/nav_state_of.h"
-#include "common/estimator/state_helper.h"
 #include "common/eval/json.h"
-#include "common/eval/pixel_frontend.h"
 #include "common/eval/writers.h"
-#include "common/math/quat.h"
-#include "common/sim/simulator.h"
-#include "common/target/target_conversion.h"
 #include "common/target/target_filter_config.h"
-#include "common/time/utime.h"
 
 namespace vimot {
 namespace eval {
 
-using estimator::FrameStatus;
-using estimator::StateHelper;
-using estimator::VioEstimator;
 using target::TargetFilterOptions;
 using target::TargetRepresentation;
 using target::TargetUpdateMode;
@@ -35,126 +20,6 @@ target::TargetFilterOptions target_filter_options(const Config& config) {
   const target::TargetSection t = target::target_section_from_config(config);
   if (!t.enabled) config.fail("target.mode", "none attaches no filter: not a target-filter evaluation");
   return t.filter;
-}
-
-TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
-                                  const std::optional<target::TargetFilterOptions>& filter_options,
-                                  uint64_t perturb_seed, const std::function<void(double)>& progress,
-                                  bool keep_samples, const std::optional<frontend::FeatureTrackerOptions>& pixels,
-                                  const std::optional<segmentation::BoxChainOptions>& box_chain) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  sim::SimConfig cfg = sim_config;
-  cfg.ground_truth_events = true;
-  sim::Simulator sim(cfg);
-  std::optional<PixelFrontEnd> pixel_frontend;
-  if (pixels) pixel_frontend.emplace(sim, *pixels, box_chain);
-  VioEstimator est(options);
-  TargetRunResult r;
-  r.sim_seed = cfg.seed;
-  r.perturb_seed = perturb_seed;
-  const int64_t frames_total = std::max<int64_t>(1, sim.camera_frame_count());
-
-  const estimator::InitialEstimate x0 = estimator::initial_estimate(sim.initial_state(), options, perturb_seed);
-  est.initialize(x0.value, sim.initial_state().utime, x0.P0);
-  std::unique_ptr<target::TargetFilter> filter;
-  if (filter_options) {
-    target::TargetFilterOptions f = *filter_options;
-    f.init_perturb_seed = perturb_seed;  // the target starts perturbed like the robot
-    filter = std::make_unique<target::TargetFilter>(est, f);
-  }
-
-  TrajectoryErrors e_ti, e_tg, e_imu;
-  GroundTruth truth;
-  bool have_truth = false;
-  bool target_seen = false;
-  int64_t first_target_utime = 0;
-  int64_t frames_seen = 0;
-  int64_t gap = 0;
-  auto on_truth = [&](const GroundTruth& gt) {
-    truth = gt;
-    have_truth = true;
-    if (filter) filter->set_ground_truth(gt);
-  };
-  play_simulator(sim, est, on_truth, [&](const CameraFrame& frame) {
-    ++frames_seen;
-    bool has_target_obs = false;
-    for (const FeatureObservation& o : frame.observations) has_target_obs = has_target_obs || o.is_target;
-    if (has_target_obs && !target_seen) first_target_utime = frame.utime;
-    target_seen = target_seen || has_target_obs;
-    const int64_t used_before = filter ? filter->stats().obs_used : 0;
-    const FrameStatus st = est.feed_camera(frame);
-    if (progress) progress(static_cast<double>(frames_seen) / static_cast<double>(frames_total));
-    if (st == FrameStatus::kDiverged) {
-      r.diverged = true;
-      r.divergence_reason = est.last_divergence().reason;
-      return false;
-    }
-    if (st != FrameStatus::kProcessed) return true;
-    if (!have_truth || truth.utime != frame.utime || !target_seen) return true;
-    gap = has_target_obs ? 0 : gap + 1;
-    r.longest_gap_frames = std::max(r.longest_gap_frames, gap);
-    r.frames_with_target_obs += has_target_obs ? 1 : 0;
-    if (filter) r.frames_with_target_update += filter->stats().obs_used > used_before ? 1 : 0;
-    try {
-      e_imu.add(error_of(estimator::nav_state_of(est, true), truth));
-      if (filter && filter->initialized() && truth.has_target) {
-        if (!r.target_initialized) r.target_init_s = utime_to_seconds(frame.utime - first_target_utime);
-        r.target_initialized = true;
-        const estimator::State& s = est.state();
-        const target::PoseValue ip = target::imu_pose(est.imu_value());
-        const target::TargetValue x = filter->value();
-        const Eigen::Matrix<double, 18, 18> P18 =
-            StateHelper::marginal_covariance(s, {s.imu()->pose()->q(), s.imu()->pose()->p(), filter->target()});
-        target::TargetValue x_i, x_g;
-        target::Matrix12d P_i, P_g;
-        if (filter->options().representation == TargetRepresentation::kLocal) {
-          x_i = x;
-          P_i = P18.block<12, 12>(6, 6);
-          x_g = target::local_to_global(ip, x);
-          P_g = target::local_to_global_covariance(ip, x, P18);
-        } else {
-          x_g = x;
-          P_g = P18.block<12, 12>(6, 6);
-          x_i = target::global_to_local(ip, x);
-          P_i = target::global_to_local_covariance(ip, x, P18);
-        }
-        // A frame of the filter's own (features start): fixed at its first estimate.
-        if (e_ti.count() == 0 && filter->options().init_mode == target::TargetInitMode::kFeatures) {
-          r.target_frame = target_frame_transform(truth, x_i.q_RtoT, x_i.p_TinR);
-        }
-        const GroundTruth t = in_target_frame(truth, r.target_frame);
-        const TargetInImu truth_in_imu = true_target_in_imu(t);
-        const ErrorSample ti = compute_error(frame.utime, truth_in_imu.q_ItoT, truth_in_imu.p_TinI, x_i.q_RtoT, x_i.p_TinR,
-                                             P_i.block<3, 3>(0, 0), P_i.block<3, 3>(3, 3));
-        const ErrorSample tg = compute_error(frame.utime, t.q_GtoT, t.p_TinG, x_g.q_RtoT, x_g.p_TinR,
-                                             P_g.block<3, 3>(0, 0), P_g.block<3, 3>(3, 3));
-        e_ti.add(ti);
-        e_tg.add(tg);
-        r.target_max_error_m = std::max(r.target_max_error_m, ti.err_p.norm());
-        if (keep_samples) {
-          r.target_in_imu_samples.push_back(ti);
-          r.target_in_world_samples.push_back(tg);
-        }
-      }
-    } catch (const std::invalid_argument& e) {
-      r.diverged = true;
-      r.divergence_reason = "covariance not positive definite at utime " + std::to_string(frame.utime) + ": " + e.what();
-      return false;
-    }
-    return true;
-  }, pixel_frontend ? &*pixel_frontend : nullptr);
-  if (progress) progress(1.0);
-  r.target_in_imu = e_ti.summary();
-  r.target_in_world = e_tg.summary();
-  r.imu = e_imu.summary();
-  r.frames_processed = est.frames_processed();
-  if (filter) r.target_stats = filter->stats();
-  if (filter && !r.diverged && filter_options->mode != TargetUpdateMode::kOff && !r.target_initialized) {
-    r.diverged = true;
-    r.divergence_reason = "target never initialised";
-  }
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  return r;
 }
 
 TargetCellSummary summarize(const TargetCell& cell) {
@@ -174,51 +39,6 @@ TargetCellSummary summarize(const TargetCell& cell) {
   s.target_in_world = aggregate(tg);
   s.imu = aggregate(imu);
   return s;
-}
-
-std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estimator::VioOptions& options,
-                                         const target::TargetFilterOptions& base_filter, const TargetSweepOptions& o,
-                                         const std::function<void(const MonteCarloProgress&)>& progress) {
-  if (o.runs < 1) throw std::invalid_argument("run_target_sweep: runs must be >= 1, got " + std::to_string(o.runs));
-  options.validate();
-  sim::validate(base);
-  std::vector<TargetCell> cells;
-  if (o.vio_only) {
-    TargetCell c;
-    c.vio_only = true;
-    cells.push_back(c);
-  }
-  for (TargetUpdateMode m : o.modes) {
-    for (TargetRepresentation rep : o.representations) {
-      for (double sigma : o.sigmas) {
-        TargetCell c;
-        c.filter = base_filter;
-        c.filter.mode = m;
-        c.filter.representation = rep;
-        c.filter.sigma_t = sigma;
-        cells.push_back(c);
-      }
-    }
-  }
-  if (cells.empty()) throw std::invalid_argument("run_target_sweep: nothing to run");
-  for (TargetCell& c : cells) c.runs.resize(static_cast<std::size_t>(o.runs));
-  const int jobs = static_cast<int>(cells.size()) * o.runs;
-  run_parallel(
-      jobs, o.threads,
-      [&](int j, const std::function<void(double)>& fr) {
-        TargetCell& c = cells[static_cast<std::size_t>(j / o.runs)];
-        const int i = j % o.runs;
-        const uint64_t seed = o.first_seed + static_cast<uint64_t>(i);
-        sim::SimConfig cfg = base;
-        cfg.seed = seed;
-        std::optional<TargetFilterOptions> f;
-        if (!c.vio_only) f = c.filter;
-        c.runs[static_cast<std::size_t>(i)] =
-            run_target_on_sim(cfg, options, f, o.fixed_perturb_seed.value_or(estimator::perturb_seed_for_run(seed)), fr,
-                              o.keep_samples, o.pixels, o.box_chain);
-      },
-      progress);
-  return cells;
 }
 
 namespace {

@@ -1,36 +1,38 @@
 #pragma once
 // The joint robot + target filter (common/target/target_filter.h) on the
-// simulator, evaluated against its truth: one run, the σ_t sweep of
+// simulator, evaluated against its truth: what one run and the σ_t sweep of
 // Eckenhoff et al., "Schmidt-EKF-based Visual-Inertial Moving Object
-// Tracking", Sec. IV (Tables I and II), and its tables and summary files
-// (vimot-target-eval). No LCM here.
+// Tracking", Sec. IV (Tables I and II) measure, and their tables and
+// summary files (vimot-target-eval). The runs drive the `target_filter`
+// process's Node fed the simulator's messages as over LCM
+// (procs/eval/target_run.h). No LCM here.
 //
-// One run is run_vio_on_sim's run (same simulator, same perturbed IMU start
-// initial_estimate(..., perturb_seed)) with a TargetFilter attached (none
-// for the VIO-only row); before every camera frame the filter gets the
-// GroundTruth of that utime (set_ground_truth), which it uses only with
-// init mode ground_truth (the target initialised from the truth at the
-// first frame with target observations, as in
-// tests/target/target_filter_test.cc); with init mode features the filter
-// starts from its own target features and the truth is taken in the
-// filter's target frame (target_frame.h, fixed at the filter's first
-// estimate, reported in TargetRunResult::target_frame). Samples: every processed frame
-// with truth at or after the first frame with target observations (the
-// same frames with and without the filter); the target errors only once the
-// filter is initialised. Per sample (error conventions of metrics.h, the
-// target's left error R = Exp(−δθ) R̂ for the orientations):
+// One run is vimot-vio-eval's run (same simulator, same perturbed IMU start
+// initial_estimate(..., perturb_seed)) with the TargetFilter attached (none
+// for the VIO-only row); the node buffers the ground truth and gives the
+// filter the truth of a frame's utime, which it uses only with init mode
+// ground_truth (the target initialised from the truth at the first frame
+// with target observations, as in tests/target/target_filter_test.cc); with
+// init mode features the filter starts from its own target features and the
+// truth is taken in the filter's target frame (target_frame.h, fixed at the
+// filter's first estimate, reported in TargetRunResult::target_frame).
+// Samples: every processed frame with truth at or after the first frame with
+// target observations (the same frames with and without the filter); the
+// target errors only once the filter is initialised. Per sample (error
+// conventions of metrics.h, the target's left error R = Exp(−δθ) R̂ for the
+// orientations):
 //  * target in IMU [q_ItoT, p_TinI]: local directly, global through
 //    global_to_local (covariance by global_to_local_covariance);
 //  * target in world [q_GtoT, p_TinG]: global directly, local through
 //    local_to_global (local_to_global_covariance);
-//  * IMU in world: error_of(nav_state_of(estimator, true), truth), as
+//  * IMU in world: error_of(the published NAV_STATE, truth), as
 //    vimot-vio-eval.
 // RMSE and mean NEES per run (TrajectoryErrors); a cell of the sweep
 // averages its runs (diverged runs are left out and counted).
-// From pixels (`pixels` set): the frames are the features PixelFrontEnd
-// tracks in the rendered images (true box, or with a box chain the segmenter
-// and mask filter's box), as vimot-vio-eval --pixels; the
-// truth and the samples are the same.
+// From pixels (`pixels` set): the frames are the features the feature
+// tracker Node tracks in the rendered images (true box, or with a box chain
+// the segmenter and mask filter Nodes' box), as vimot-vio-eval --pixels;
+// the truth and the samples are the same.
 
 #include <cstdint>
 #include <optional>
@@ -89,17 +91,6 @@ struct TargetRunResult {
   std::vector<ErrorSample> target_in_world_samples;
 };
 
-/// One run on `sim_config` (its seed and duration); filter == nullopt: VIO
-/// only. `progress` gets the fraction of camera frames done. keep_samples:
-/// also return the per-frame target errors. pixels: frames from the rendered
-/// images through the feature tracker with these options; box_chain (with
-/// pixels): the target box from the segmenter and mask filter, not the truth.
-TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estimator::VioOptions& options,
-                                  const std::optional<target::TargetFilterOptions>& filter, uint64_t perturb_seed,
-                                  const std::function<void(double)>& progress = {}, bool keep_samples = false,
-                                  const std::optional<frontend::FeatureTrackerOptions>& pixels = std::nullopt,
-                                  const std::optional<segmentation::BoxChainOptions>& box_chain = std::nullopt);
-
 /// One cell of the sweep: a filter configuration (or VIO only) × runs.
 struct TargetCell {
   bool vio_only{false};
@@ -134,15 +125,6 @@ struct TargetSweepOptions {
   std::optional<frontend::FeatureTrackerOptions> pixels;
   std::optional<segmentation::BoxChainOptions> box_chain;  // as run_target_on_sim's
 };
-
-/// Every cell (VIO only first, then modes × representations × sigmas in
-/// that nesting) × runs on o.threads threads (run_parallel); run i of every
-/// cell uses simulator seed first_seed + i and perturbation seed
-/// perturb_seed_for_run(first_seed + i). Deterministic whatever the thread
-/// count. `base_filter` gives the options not swept.
-std::vector<TargetCell> run_target_sweep(const sim::SimConfig& base, const estimator::VioOptions& options,
-                                         const target::TargetFilterOptions& base_filter, const TargetSweepOptions& o,
-                                         const std::function<void(const MonteCarloProgress&)>& progress = {});
 
 /// Markdown tables in the layout of the paper's Tables I (EKF) and II (SKF):
 /// rows σ_t, column groups global | local, each "target in IMU, target in

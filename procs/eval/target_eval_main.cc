@@ -27,6 +27,7 @@
 #include "common/sim/simulator.h"
 #include "common/target/target_filter_config.h"
 #include "procs/eval/monte_carlo_args.h"
+#include "procs/eval/target_run.h"
 
 namespace {
 
@@ -178,7 +179,8 @@ int run(int argc, const char* const* argv) {
   const auto t0 = std::chrono::steady_clock::now();
   eval::ProgressBar bar(!args.flag("quiet"));
   const std::vector<eval::TargetCell> cells = eval::run_target_sweep(
-      sim_cfg, options, base_filter, o, [&bar](const eval::MonteCarloProgress& p) { bar.update(p); });
+      sim_cfg, options, base_filter, o, [&bar](const eval::MonteCarloProgress& p) { bar.update(p); },
+      input_guard_options_from_config(Config::load_file(vins_path)));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const eval::MachineInfo machine = eval::machine_info();

@@ -22,6 +22,7 @@
 #include "common/process/logger.h"
 #include "common/sim/simulator.h"
 #include "procs/eval/monte_carlo_args.h"
+#include "procs/eval/vio_run.h"
 
 namespace {
 
@@ -86,7 +87,8 @@ int run(int argc, const char* const* argv) {
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar(!args.flag("quiet"));
   const std::vector<eval::SimRunResult> results =
-      eval::run_monte_carlo(sim_cfg, options, mc, [&bar](const eval::MonteCarloProgress& p) { bar.update(p); });
+      eval::run_monte_carlo(sim_cfg, options, mc, [&bar](const eval::MonteCarloProgress& p) { bar.update(p); },
+                            input_guard_options_from_config(Config::load_file(vins_path)));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const eval::MachineInfo machine = eval::machine_info();

@@ -18,6 +18,7 @@
 #include "common/sim/simulator.h"
 #include "common/types/ground_truth.h"
 #include "common/types/sensor_data.h"
+#include "procs/eval/vio_run.h"
 
 using namespace vimot;
 using namespace vimot::estimator;

@@ -22,6 +22,7 @@
 #include "common/eval/writers.h"
 #include "common/math/quat.h"
 #include "common/process/lcm_conversions.h"
+#include "procs/eval/vio_run.h"
 
 using namespace vimot;
 using namespace vimot::eval;

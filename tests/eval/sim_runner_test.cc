@@ -14,6 +14,7 @@
 #include "common/eval/report.h"
 #include "common/eval/sim_runner.h"
 #include "common/sim/simulator.h"
+#include "procs/eval/vio_run.h"
 
 using namespace vimot;
 using namespace vimot::eval;

@@ -13,6 +13,7 @@
 #include "common/eval/target_eval.h"
 #include "common/eval/writers.h"
 #include "common/sim/simulator.h"
+#include "procs/eval/target_run.h"
 
 using namespace vimot;
 using namespace vimot::eval;

@@ -13,6 +13,7 @@
 #include "common/eval/target_eval.h"
 #include "common/frontend/tracker_options.h"
 #include "common/sim/sim_config.h"
+#include "procs/eval/target_run.h"
 
 using namespace vimot;
 

@@ -20,6 +20,7 @@
 #include "tests/procs/paper_events.h"
 #include "procs/target_filter/target_filter_node.h"
 #include "procs/vins/vins_node.h"
+#include "procs/eval/target_run.h"
 
 using namespace vimot;
 

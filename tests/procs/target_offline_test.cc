@@ -15,6 +15,7 @@
 #include "common/sim/simulator.h"
 #include "procs/target_filter/target_filter_node.h"
 #include "tests/procs/paper_events.h"
+#include "procs/eval/target_run.h"
 
 using namespace vimot;
 

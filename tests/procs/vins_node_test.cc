@@ -14,6 +14,7 @@
 #include "common/sim/simulator.h"
 #include "procs/vins/vins_node.h"
 #include "tests/procs/paper_events.h"
+#include "procs/eval/vio_run.h"
 
 using namespace vimot;
 

@@ -22,6 +22,7 @@
 #include "common/estimator/vins_config.h"
 #include "common/eval/target_eval.h"
 #include "common/sim/sim_config.h"
+#include "procs/eval/target_run.h"
 
 using namespace vimot;
 using namespace vimot::eval;
