@@ -1,10 +1,11 @@
 // Offline equals LCM for the target filter: the process logic
 // (TargetFilterNode) on the simulator's events publishes target states
 // whose errors against the truth, matched as vimot-log-eval matches
-// a recorded run (eval::TruthMatcher), are exactly those of the offline
-// evaluator (eval::run_target_on_sim, vimot-target-eval) on the same
-// scenario, options and perturbation, for both target starts (init.mode
-// features through the fixed target-frame transform, and ground_truth).
+// a recorded run (eval::TruthMatcher), are exactly those the offline
+// evaluator (eval::run_target_on_sim, vimot-target-eval, which runs the
+// same Node) samples on the same scenario, options and perturbation, for
+// both target starts (init.mode features through the fixed target-frame
+// transform, and ground_truth).
 #include <catch2/catch.hpp>
 
 #include <variant>

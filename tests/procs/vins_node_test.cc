@@ -76,8 +76,9 @@ TEST_CASE("vins node output does not depend on message interleaving", "[vins]") 
 }
 
 TEST_CASE("vins node publishes exactly the offline evaluator's states", "[vins]") {
-  // Offline equals LCM: the same scenario, options and perturbation through
-  // the evaluator (eval::run_vio_on_sim) and through the process logic.
+  // The evaluator (eval::run_vio_on_sim) samples exactly the states the node
+  // publishes on the simulator's messages fed directly (its own feeding goes
+  // through the LCM structs, procs/eval/sim_pipeline.h).
   sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
   cfg.seed = 5;
   cfg.duration = 8.0;
