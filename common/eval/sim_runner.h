@@ -54,10 +54,10 @@ struct FrameSample {
 struct SimRunOptions {
   bool keep_samples{true};  // false: only the summary (long Monte Carlo)
   /// Set: frames from pixels — rendered images through the feature tracker
-  /// with these options (PixelFrontEnd) instead of the simulated tracks.
+  /// with these options instead of the simulated tracks.
   std::optional<frontend::FeatureTrackerOptions> pixels;
   /// With pixels: the target box from the segmenter and mask filter
-  /// (PixelFrontEnd's box chain) instead of the truth.
+  /// instead of the truth.
   std::optional<segmentation::BoxChainOptions> box_chain;
   /// Fraction of the run's camera frames done, after every frame (called
   /// on the thread running the simulation).
