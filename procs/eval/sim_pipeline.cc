@@ -1,5 +1,6 @@
 #include "procs/eval/sim_pipeline.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -84,14 +85,14 @@ void SimPipeline::camera_frame(const CameraFrame& simulated) {
     tracker_->on_image(view.camera_id, view.utime, image);
     if (segmenter_) {
       if (segmenter_->uses_truth()) {
-        segmenter_->on_true_mask(view.camera_id, view.utime, mask_from_lcm(to_lcm_mask(view.mask, view.utime, view.camera_id)));
+        const mask_t truth = to_lcm_mask(view.mask, view.utime, view.camera_id);
+        segmenter_->on_true_mask(view.camera_id, view.utime, mask_from_lcm(truth));
       } else {
         segmenter_->on_image(view.camera_id, view.utime, image);
       }
     } else {
       // TARGET_BOX_TRUTH: a perfect detection when the target is visible.
-      tracker_->on_box(view.camera_id, view.utime,
-                       view.visible ? box_from(view.box) : std::nullopt);
+      tracker_->on_box(view.camera_id, view.utime, view.visible ? box_from(view.box) : std::nullopt);
     }
   }
 }

@@ -1,6 +1,7 @@
 // vimot-target-eval: the σ_t sweep of Eckenhoff et al., "Schmidt-EKF-based
 // Visual-Inertial Moving Object Tracking", Sec. IV (Tables I and II), on the
-// simulator, offline (no LCM): joint robot + target filter (EKF / SKF,
+// simulator, offline (the target_filter process's Node fed the simulator's
+// messages as over LCM, no network: target_run.h): joint robot + target filter (EKF / SKF,
 // global / local) and the VIO-only reference, N Monte-Carlo runs per cell.
 // Run i of every cell uses simulator seed first_seed + i and the perturbed
 // IMU start of vimot-vio-eval; the target starts from its own features (or
@@ -78,7 +79,8 @@ int merge(const ArgParser& args) {
 int run(int argc, const char* const* argv) {
   ArgParser args("vimot-target-eval",
                  "Monte-Carlo σ_t sweep of the joint robot + target filter on the simulator (paper\n"
-                 "Tables I and II), offline (no LCM). Per σ_t × mode (ekf, skf) × representation\n"
+                 "Tables I and II), offline: the target_filter process's logic fed the simulator's\n"
+                 "messages as over LCM, with no network. Per σ_t × mode (ekf, skf) × representation\n"
                  "(global, local), plus the VIO-only row: average over runs of the RMSE of the\n"
                  "target pose in the IMU frame, the target pose in the world and the IMU pose\n"
                  "(m / deg), over the camera frames after the target initialisation, and NEES.\n"

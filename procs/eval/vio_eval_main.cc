@@ -1,5 +1,6 @@
 // vimot-vio-eval: Monte-Carlo accuracy and consistency of the VIO estimator
-// on the simulator, offline (no LCM), configured from the same vins config
+// on the simulator, offline (the vins process's Node fed the simulator's
+// messages as over LCM, no network: vio_run.h), configured from the same vins config
 // as the `vins` process. Runs are independent std::threads; run i uses
 // simulator seed first_seed + i. Prints a per-run table and the average;
 // --out writes TUM trajectories, per-frame error CSVs and summaries.
@@ -39,7 +40,8 @@ std::string seed_name(uint64_t seed) {
 
 int run(int argc, const char* const* argv) {
   ArgParser args("vimot-vio-eval",
-                 "Monte-Carlo evaluation of the VIO estimator on the simulator, offline (no LCM).\n"
+                 "Monte-Carlo evaluation of the VIO estimator on the simulator, offline: the vins\n"
+                 "process's logic fed the simulator's messages as over LCM, with no network.\n"
                  "Run i simulates with seed first_seed+i and starts from the truth perturbed by a\n"
                  "sample of P0 (seed derived from the simulator seed). Prints per run and on\n"
                  "average: position RMSE [m], orientation RMSE [deg], NEES of position and\n"

@@ -92,8 +92,8 @@ TEST_CASE("vimot-target-eval's figures are those of its seed replayed through th
   const TargetFilterNodeOptions o =
       node_options_from_config(Config::load_file(kSource + "/config/target_filter.yaml"));
   REQUIRE(o.target.init_mode == target::TargetInitMode::kFeatures);
-  const eval::TargetRunResult offline =
-      eval::run_target_on_sim(scenario(), o.vio, o.target, kPerturbSeed, {}, false, std::nullopt, std::nullopt, o.input);
+  const eval::TargetRunResult offline = eval::run_target_on_sim(scenario(), o.vio, o.target, kPerturbSeed, {}, false,
+                                                                std::nullopt, std::nullopt, o.input);
   REQUIRE_FALSE(offline.diverged);
   REQUIRE(offline.target_in_imu.count >= 40);
 
