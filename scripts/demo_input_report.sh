@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
-# Per process and input stream of a demo run: what the simulator published,
-# what the process received, and what its heartbeat counted as lost (from
-# the sheriff's output: the simulator's "done:" line and each process's
-# "stopping:" line, common/process/process.h). Published − received is what
-# the network lost; a process that counts its input exactly says the same.
-# With the run's LCM log: also what each process published against what
-# the logger recorded (the logger has no heartbeat; its loss changes the
-# figures evaluated from the log too).
+# Per process and input channel of a demo run: what its publishers sent,
+# what the process received ("in"), and what its heartbeat counted as lost
+# (from the sheriff's output: the simulator's "done:" line, and each
+# process's "stopping:" line, common/process/process.h, which also gives
+# what it published, "out <channel>"). Every process stopped with input
+# still queued drains it or counts it as lost, so per channel
+#   published = received + counted lost
+# exactly, unless the network itself lost messages at the very end. This
+# covers the logger (vimot-logger counts what it logged per channel); with
+# the run's LCM log also what the log holds against what the logger says.
+# Channels with no counted publisher (HEARTBEAT) are left out.
 #   scripts/demo_input_report.sh SHERIFF_OUTPUT [LCM_LOG]
-# Exits 1 if some process's count differs from what it missed ("NOT COUNTED":
-# e.g. input still queued, or lost at the end, when the process was stopped:
-# no later message shows the gap).
+# Exits 1 naming each channel whose count is not exact ("NOT COUNTED"),
+# each process that left no "stopping:" line (killed: "NO FINAL COUNT") and
+# each channel whose log holds other than what the logger received
+# ("LOG DIFFERS").
 set -euo pipefail
 if [ $# -lt 1 ] || [ $# -gt 2 ] || [ "$1" = -h ] || [ "$1" = --help ]; then
   awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"
@@ -26,45 +30,46 @@ fi
 awk '
   FILENAME == ARGV[1] { if ($2 ~ /^vimot\./) logged[$1] = $3; next }
   function items(text, out,   n, parts, i) { n = split(text, parts, ", "); for (i = 1; i <= n; ++i) out[i] = parts[i]; return n }
+  function proc_name(   name) { name = $1; gsub(/[][]/, "", name); return name }
   /\[sim\].*INFO: (done|stopped early): / {
     text = $0; sub(/.*INFO: (done|stopped early): /, "", text)
     n = items(text, it)
-    for (i = 1; i <= n; ++i) { split(it[i], w, " "); if (w[2] == "on") { published[w[3]] = w[1]; streams[++ns] = w[3] } }
+    for (i = 1; i <= n; ++i) { split(it[i], w, " "); if (w[2] == "on") { published[w[3]] = w[1]; sim_streams[w[3]] = 1 } }
   }
+  /INFO: started \(pid/ { name = proc_name(); if (name != "sim" && !(name in started)) { started[name] = 1; order[++np] = name } }
   /INFO: stopping: in / {
-    name = $1; gsub(/[][]/, "", name)
+    name = proc_name(); stopped[name] = 1
     text = $0; sub(/.*INFO: stopping: /, "", text)
-    if (!(name in seen)) { seen[name] = 1; procs[++np] = name }
     n = items(text, it)
     for (i = 1; i <= n; ++i) {
       k = split(it[i], w, " ")
       if (k == 3 && (w[1] == "in" || w[1] == "lost" || w[1] == "out")) count[name, w[1], w[2]] = w[3]
-      if (k == 3 && w[1] == "out") outs[name] = outs[name] " " w[2]
+      if (k == 3 && w[1] == "in" && !((name, w[2]) in has_in)) { has_in[name, w[2]] = 1; ins[name] = ins[name] " " w[2] }
+      if (k == 3 && w[1] == "out") out_total[w[2]] += w[3]
       if (k == 2 && (w[1] == "dropped" || w[1] == "lost" || w[1] == "errors")) count[name, w[1]] = w[2]
     }
   }
   END {
-    if (ns == 0) { print "no \"done:\" line of the simulator: nothing to compare"; exit 1 }
+    if (length(published) == 0) { print "no \"done:\" line of the simulator: nothing to compare"; exit 1 }
+    for (ch in out_total) if (!(ch in sim_streams)) published[ch] = out_total[ch]
     status = 0
-    if (length(logged) > 0) {
-      printf "logger:\n"
-      for (s = 1; s <= ns; ++s) printf "  %-13s published %6d  logged   %6d\n", streams[s], published[streams[s]], logged[streams[s]]
-    }
     for (p = 1; p <= np; ++p) {
-      name = procs[p]; rows = ""
-      for (s = 1; s <= ns; ++s) {
-        ch = streams[s]
-        if (!((name, "in", ch) in count)) continue
-        missed = published[ch] - count[name, "in", ch]; lost = count[name, "lost", ch] + 0
-        rows = rows sprintf("  %-13s published %6d  received %6d  counted lost %d", ch, published[ch], count[name, "in", ch], lost)
-        if (missed != lost) { rows = rows sprintf("  NOT COUNTED: %d missed", missed); status = 1 }
-        rows = rows "\n"
-      }
-      if (length(logged) > 0) {
-        n = split(outs[name], chans, " ")
-        for (i = 1; i <= n; ++i) {
-          rows = rows sprintf("  %-13s published %6d  logged   %6d\n", chans[i], count[name, "out", chans[i]], logged[chans[i]])
+      name = order[p]
+      if (!(name in stopped)) { printf "%s: NO FINAL COUNT (no \"stopping:\" line: killed?)\n", name; status = 1; continue }
+      rows = ""
+      n = split(ins[name], chans, " ")
+      for (i = 1; i <= n; ++i) {
+        ch = chans[i]
+        if (!(ch in published)) continue
+        received = count[name, "in", ch]; lost = count[name, "lost", ch] + 0
+        rows = rows sprintf("  %-13s published %6d  received %6d  counted lost %d", ch, published[ch], received, lost)
+        if (published[ch] != received + lost) {
+          rows = rows sprintf("  NOT COUNTED: %d missed", published[ch] - received - lost); status = 1
         }
+        if (length(logged) > 0 && name == "logger" && logged[ch] + 0 != received) {
+          rows = rows sprintf("  LOG DIFFERS: the log holds %d", logged[ch]); status = 1
+        }
+        rows = rows "\n"
       }
       if (rows != "") printf "%s (dropped %d, lost %d, errors %d):\n%s", name, count[name, "dropped"], count[name, "lost"], count[name, "errors"], rows
     }

@@ -39,10 +39,12 @@ template <typename Node>
 int run_estimator_node(Process& process, Node& node, bool use_ground_truth, double max_wait_s) {
   using Clock = std::chrono::steady_clock;
   Clock::time_point last_imu_wall = Clock::now();
-  // 10 s of input at the simulator's 200 Hz IMU and ground truth, 10 Hz
-  // frames (≈ 3 MB at most) wait while a frame update runs long on a loaded
-  // CPU; LCM's default queue (30 messages, 0.15 s of IMU) dropped them.
-  constexpr int kImuQueue = 2000, kFeaturesQueue = 100;
+  // 60 s of input at the simulator's 200 Hz IMU and ground truth, 10 Hz
+  // frames (≈ 15 MB at most) wait while a frame update runs long on a
+  // loaded CPU (LCM's default queue, 30 messages, is 0.15 s of IMU); what a
+  // process that fell behind still holds when stopped is drained or counted
+  // (Process, --drain).
+  constexpr int kImuQueue = 12000, kFeaturesQueue = 600;
   process.subscribe<imu_t>(
       process.channel("imu", "IMU"),
       [&](const imu_t& m) {

@@ -33,6 +33,11 @@ Process::Process(std::string name, std::string summary, bool config_required)
   args_.add_option("lcm-url", "URL", "LCM provider URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   args_.add_option("config", "FILE", config_required ? "YAML configuration (required)" : "YAML configuration");
   args_.add_option("log-level", "LEVEL", "debug, info, warn or error", "info");
+  args_.add_option("drain", "SECONDS",
+                   "when stopped, go on handling the input already queued for at most this long; what is "
+                   "left is counted as lost per channel",
+                   "0");
+  args_.add_option("drain-quiet", "SECONDS", "with --drain: stop draining once no input came for this long", "0.5");
 }
 
 Process::~Process() = default;
@@ -45,6 +50,11 @@ bool Process::init(int argc, const char* const* argv) {
     config_ = Config::load_file(args_.get("config"));
   } else if (config_required_) {
     throw ArgError(name_ + ": --config FILE is required (see --help)");
+  }
+  for (const char* key : {"drain", "drain-quiet"}) {
+    if (!(args_.get_double(key) >= 0.0)) {
+      throw ArgError(name_ + ": --" + key + " must be >= 0 seconds, got '" + args_.get(key) + "'");
+    }
   }
   const std::string url = args_.get("lcm-url");
   lcm_ = std::make_unique<lcm::LCM>(url);
@@ -60,12 +70,52 @@ std::string Process::channel(const std::string& role, const std::string& fallbac
   return config_.get_or<std::string>("channels." + role, fallback);
 }
 
-void Process::handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
-                         const std::function<bool(const void*, int)>& decode_and_call) {
+namespace {
+// Adds `n` to the count of `key` (kept in first-seen order).
+void add_count(std::vector<std::pair<std::string, int64_t>>* counts, const std::string& key, int64_t n) {
+  auto it = std::find_if(counts->begin(), counts->end(), [&](const auto& kc) { return kc.first == key; });
+  if (it == counts->end()) it = counts->insert(counts->end(), {key, 0});
+  it->second += n;
+}
+}  // namespace
+
+void Process::add_subscription(
+    const std::string& channel, bool literal,
+    std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call, int queue_capacity) {
+  auto sub = std::make_unique<RawSubscription>();
+  sub->owner = this;
+  sub->decode_and_call = std::move(decode_and_call);
+  lcm::Subscription* lcm_sub = lcm_->subscribeFunction(
+      channel,
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string& chan, RawSubscription* s) {
+        s->owner->handle_raw(rbuf, chan, s);
+      },
+      sub.get());
+  subscriptions_.push_back(std::move(sub));
+  if (literal) add_count(&in_by_channel_, channel, 0);
+  if (queue_capacity > 0 && lcm_sub != nullptr) lcm_sub->setQueueCapacity(queue_capacity);
+}
+
+void Process::subscribe_raw(const std::string& channel_regex, RawHandler handler, int queue_capacity) {
+  add_subscription(
+      channel_regex, false,
+      [handler = std::move(handler)](const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+        handler(channel, rbuf->recv_utime, rbuf->data, static_cast<int>(rbuf->data_size));
+        return true;
+      },
+      queue_capacity);
+}
+
+void Process::handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, RawSubscription* sub) {
+  if (counting_left_) {
+    add_count(&left_by_channel_, channel, 1);
+    return;
+  }
+  add_count(&in_by_channel_, channel, 1);
   ++counters_.messages_in;
   bool decoded = false;
   try {
-    decoded = decode_and_call(rbuf->data, static_cast<int>(rbuf->data_size));
+    decoded = sub->decode_and_call(rbuf, channel);
   } catch (const std::exception& e) {
     report_error("handling " + channel + ": " + e.what());
     return;
@@ -98,15 +148,6 @@ void Process::set_counter(const std::string& name, int64_t value) {
   extra_counters_.emplace_back(name, value);
 }
 
-namespace {
-// Adds `n` to the count of `key` (kept in first-seen order).
-void add_count(std::vector<std::pair<std::string, int64_t>>* counts, const std::string& key, int64_t n) {
-  auto it = std::find_if(counts->begin(), counts->end(), [&](const auto& kc) { return kc.first == key; });
-  if (it == counts->end()) it = counts->insert(counts->end(), {key, 0});
-  it->second += n;
-}
-}  // namespace
-
 void Process::report_lost(int64_t count, const std::string& why, const std::string& stream) {
   counters_.lost += count;
   if (!stream.empty()) add_count(&lost_by_stream_, stream, count);
@@ -116,7 +157,7 @@ void Process::report_lost(int64_t count, const std::string& why, const std::stri
 void Process::count_published(const std::string& channel) { add_count(&out_by_channel_, channel, 1); }
 
 void Process::update_stream_counters() {
-  for (const auto& s : subscriptions_) set_counter("in " + s->channel, s->received);
+  for (const auto& [channel, n] : in_by_channel_) set_counter("in " + channel, n);
   for (const auto& [stream, n] : lost_by_stream_) set_counter("lost " + stream, n);
   for (const auto& [channel, n] : out_by_channel_) set_counter("out " + channel, n);
 }
@@ -148,9 +189,15 @@ void Process::publish_heartbeat() {
   lcm_->publish(config_.get_or<std::string>("channels.heartbeat", "HEARTBEAT"), &hb);
 }
 
+void Process::maybe_publish_heartbeat() {
+  if (std::chrono::steady_clock::now() < next_heartbeat_) return;
+  publish_heartbeat();
+  flush_suppressed_logs();
+  next_heartbeat_ += std::chrono::seconds(1);
+}
+
 int Process::run(const std::function<void()>& idle) {
-  using Clock = std::chrono::steady_clock;
-  auto next_heartbeat = Clock::now();
+  next_heartbeat_ = std::chrono::steady_clock::now();
   while (!stop_requested()) {
     const int status = lcm_->handleTimeout(100);
     if (status < 0) {
@@ -160,12 +207,9 @@ int Process::run(const std::function<void()>& idle) {
     }
     idle_after_timeout_ = status == 0;
     if (idle) idle();
-    if (Clock::now() >= next_heartbeat) {
-      publish_heartbeat();
-      flush_suppressed_logs();
-      next_heartbeat += std::chrono::seconds(1);
-    }
+    maybe_publish_heartbeat();
   }
+  drain(idle);
   flush_suppressed_logs();
   update_stream_counters();
   std::string per_stream;
@@ -174,7 +218,45 @@ int Process::run(const std::function<void()>& idle) {
            ", decode errors ", counters_.decode_errors.load(), ", dropped ", counters_.dropped.load(), ", lost ", counters_.lost.load(),
            ", errors ", counters_.errors.load(), per_stream, ", cpu ",
            static_cast<double>(std::clock()) / CLOCKS_PER_SEC, " s");
+  publish_heartbeat();  // the final counts, for a monitor that missed the log
   return 0;
+}
+
+void Process::drain(const std::function<void()>& idle) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms = [](double s) { return static_cast<int64_t>(s * 1000.0); };
+  const int64_t quiet_ms = std::max<int64_t>(1, ms(args_.get_double("drain-quiet")));
+  const Clock::time_point deadline = Clock::now() + std::chrono::milliseconds(ms(args_.get_double("drain")));
+  // No heartbeat while draining: a logger that drains until the network is
+  // quiet would otherwise keep itself busy with its own. A second signal
+  // ends the drain (the user insists).
+  g_signal_received = false;
+  while (!g_signal_received) {
+    const int64_t left_ms = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (left_ms <= 0) break;
+    const int status = lcm_->handleTimeout(static_cast<int>(std::min(quiet_ms, left_ms)));
+    if (status == 0) break;  // quiet: the backlog is done
+    if (status < 0) {
+      if (!g_signal_received) report_error("LCM handle failed while draining");
+      break;
+    }
+    idle_after_timeout_ = false;
+    if (idle) idle();
+  }
+  // What is still queued or in the socket is not handled: lost. Short
+  // waits: only LCM's receive thread still delivers it (LCM stamps a
+  // message when that thread reads it, so time cannot tell a backlog from a
+  // source still publishing: the count stops after kCountLimit, and a live
+  // source's last messages then count as lost too).
+  constexpr auto kCountLimit = std::chrono::seconds(1);
+  const Clock::time_point count_end = Clock::now() + kCountLimit;
+  counting_left_ = true;
+  while (Clock::now() < count_end && lcm_->handleTimeout(50) > 0) {
+  }
+  counting_left_ = false;
+  for (const auto& [channel, n] : left_by_channel_) {
+    report_lost(n, std::to_string(n) + " message(s) on " + channel + " still queued when stopped", channel);
+  }
 }
 
 int run_process_main(const std::function<int()>& body) {

@@ -8,9 +8,18 @@
 // logged error instead of a crash. The algorithm never sees this class.
 //
 // Common options: --lcm-url URL (default: $LCM_DEFAULT_URL, else LCM's
-// default), --config FILE, --log-level LEVEL, --help.
+// default), --config FILE, --log-level LEVEL, --drain SECONDS,
+// --drain-quiet SECONDS, --help.
+//
+// Stopping (SIGINT/SIGTERM) never loses input silently: with --drain S the
+// input already queued is still handled, for at most S seconds and until
+// the network has been quiet for --drain-quiet; what is still queued then
+// is counted, unhandled, as lost on its channel ("lost <channel>"), so per
+// channel: what a source that stopped first published = "in" + "lost" +
+// what the network lost (docs/robustness.md).
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -71,6 +80,12 @@ class Process {
   template <typename Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity = 0);
 
+  /// The undecoded bytes of every message on the channels matching
+  /// `channel_regex` (LCM's regex), with LCM's receive time (wall clock, µs)
+  /// and the message's channel: for a logger. Counted per channel as above.
+  using RawHandler = std::function<void(const std::string& channel, int64_t recv_utime, const void* data, int size)>;
+  void subscribe_raw(const std::string& channel_regex, RawHandler handler, int queue_capacity = 0);
+
   template <typename Msg>
   void publish(const std::string& channel, const Msg& msg) {
     if (lcm_->publish(channel, &msg) == 0) {
@@ -101,6 +116,8 @@ class Process {
 
   /// Handles LCM until stop() or a signal; sends a heartbeat every second.
   /// `idle` runs after each handled batch or timeout (e.g. deferred work).
+  /// Then drains the input (--drain, above), logs the "stopping:" counts
+  /// and sends a last heartbeat with them.
   int run(const std::function<void()>& idle = {});
   /// In `idle`: the wait before it timed out, so no input is pending (a
   /// quiet network, not a backlog left by a long handler on a busy CPU).
@@ -112,8 +129,12 @@ class Process {
   void publish_heartbeat();
 
  private:
-  void handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
-                  const std::function<bool(const void*, int)>& decode_and_call);
+  struct RawSubscription;
+  void handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, RawSubscription* sub);
+  /// After the stop: handles queued input (up to --drain), then counts what
+  /// is left as lost.
+  void drain(const std::function<void()>& idle);
+  void maybe_publish_heartbeat();
 
   std::string name_;
   bool config_required_{false};
@@ -125,16 +146,27 @@ class Process {
   std::vector<std::pair<std::string, int64_t>> extra_counters_;
   std::atomic<bool> stop_requested_{false};
   bool idle_after_timeout_{false};
+  std::chrono::steady_clock::time_point next_heartbeat_{};
+
+  // While counting what is left at the stop (drain()): messages are
+  // counted per channel, not handled.
+  bool counting_left_{false};
+  std::vector<std::pair<std::string, int64_t>> left_by_channel_;
 
   // Subscriptions keep their closures alive for the LCM callbacks.
+  // `decode_and_call` returns false for a message that does not decode.
   struct RawSubscription {
     Process* owner;
-    std::string channel;
-    std::function<bool(const void*, int)> decode_and_call;
-    int64_t received{0};
+    std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call;
   };
+  /// `literal`: `channel` is one channel, counted ("in <channel>") from 0;
+  /// else a regex, whose channels are counted once seen.
+  void add_subscription(const std::string& channel, bool literal,
+                        std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call,
+                        int queue_capacity);
   void update_stream_counters();
   void count_published(const std::string& channel);
+  std::vector<std::pair<std::string, int64_t>> in_by_channel_;
   std::vector<std::pair<std::string, int64_t>> lost_by_stream_;
   std::vector<std::pair<std::string, int64_t>> out_by_channel_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
@@ -142,25 +174,15 @@ class Process {
 
 template <typename Msg>
 void Process::subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity) {
-  auto sub = std::make_unique<RawSubscription>();
-  sub->owner = this;
-  sub->channel = channel;
-  sub->decode_and_call = [handler = std::move(handler)](const void* data, int size) {
-    Msg msg;
-    if (!decode_untrusted(data, size, &msg)) return false;
-    handler(msg);  // exceptions here are the handler's: counted as errors
-    return true;
-  };
-  RawSubscription* raw = sub.get();
-  subscriptions_.push_back(std::move(sub));
-  lcm::Subscription* lcm_sub = lcm_->subscribeFunction(
-      channel,
-      +[](const lcm::ReceiveBuffer* rbuf, const std::string& chan, RawSubscription* s) {
-        ++s->received;
-        s->owner->handle_raw(rbuf, chan, s->decode_and_call);
+  add_subscription(
+      channel, true,
+      [handler = std::move(handler)](const lcm::ReceiveBuffer* rbuf, const std::string&) {
+        Msg msg;
+        if (!decode_untrusted(rbuf->data, static_cast<int>(rbuf->data_size), &msg)) return false;
+        handler(msg);  // exceptions here are the handler's: counted as errors
+        return true;
       },
-      raw);
-  if (queue_capacity > 0 && lcm_sub != nullptr) lcm_sub->setQueueCapacity(queue_capacity);
+      queue_capacity);
 }
 
 /// Runs a process main, turning any escaping exception into a one-line error

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <map>
 
 #include "common/process/process.h"
 #include "vimot/heartbeat_t.hpp"
@@ -117,4 +118,43 @@ TEST_CASE("channels come from config; a missing required config is an error") {
   Process needs_config("needs-config", "x", true);
   const char* argv[] = {"needs-config", "--lcm-url", "memq://"};
   CHECK_THROWS_WITH(needs_config.init(3, argv), Catch::Contains("--config FILE is required"));
+}
+
+// Issue 12, item 6: input still queued when the process is stopped is either
+// handled (--drain) or counted as lost on its channel, never forgotten, so
+// what a source published = "in" + "lost" per channel.
+TEST_CASE("input queued at the stop is drained with --drain, else counted as lost per channel") {
+  const bool drain = GENERATE(false, true);
+  auto p = make_process({"--drain", drain ? "5" : "0", "--drain-quiet", "0.1"});
+  int handled = 0;
+  p->subscribe<vimot::imu_t>("IMU", [&](const vimot::imu_t&) { ++handled; });
+  vimot::imu_t m{};
+  for (int i = 0; i < 100; ++i) {
+    m.utime = i;
+    p->publish("IMU", m);
+  }
+  // The last heartbeat, sent after the drain, carries the final counts.
+  vimot::heartbeat_t got{};
+  p->subscribe<vimot::heartbeat_t>("HEARTBEAT", [&](const vimot::heartbeat_t& hb) { got = hb; });
+  p->stop();  // before anything was handled: all 100 are the backlog
+  CHECK(p->run() == 0);
+  while (p->lcm().handleTimeout(10) > 0) {
+  }
+  std::map<std::string, int64_t> counters;
+  for (int i = 0; i < got.num_counters; ++i) counters[got.counter_names[i]] = got.counter_values[i];
+  INFO("--drain " << (drain ? 5 : 0));
+  CHECK(handled == (drain ? 100 : 0));
+  CHECK(counters["in IMU"] == (drain ? 100 : 0));
+  CHECK(counters.count("lost IMU") == (drain ? 0u : 1u));
+  CHECK(counters["lost IMU"] == (drain ? 0 : 100));
+  CHECK(got.dropped == (drain ? 0 : 100));
+  CHECK(got.status == (drain ? "ok" : "degraded"));
+}
+
+TEST_CASE("--drain and --drain-quiet must be non-negative seconds") {
+  for (const char* bad : {"-1", "x"}) {
+    Process p("test-proc", "x");
+    const char* argv[] = {"test-proc", "--lcm-url", "memq://", "--drain", bad};
+    CHECK_THROWS_WITH(p.init(5, argv), Catch::Contains("--drain"));
+  }
 }
