@@ -62,7 +62,7 @@ awk '
         ch = chans[i]
         if (!(ch in published)) continue
         received = count[name, "in", ch]; lost = count[name, "lost", ch] + 0
-        rows = rows sprintf("  %-13s published %6d  received %6d  counted lost %d", ch, published[ch], received, lost)
+        rows = rows sprintf("  %-17s published %6d  received %6d  counted lost %d", ch, published[ch], received, lost)
         if (published[ch] != received + lost) {
           rows = rows sprintf("  NOT COUNTED: %d missed", published[ch] - received - lost); status = 1
         }

@@ -39,12 +39,14 @@ template <typename Node>
 int run_estimator_node(Process& process, Node& node, bool use_ground_truth, double max_wait_s) {
   using Clock = std::chrono::steady_clock;
   Clock::time_point last_imu_wall = Clock::now();
-  // 60 s of input at the simulator's 200 Hz IMU and ground truth, 10 Hz
-  // frames (≈ 15 MB at most) wait while a frame update runs long on a
-  // loaded CPU (LCM's default queue, 30 messages, is 0.15 s of IMU); what a
-  // process that fell behind still holds when stopped is drained or counted
-  // (Process, --drain).
-  constexpr int kImuQueue = 12000, kFeaturesQueue = 600;
+  // 120 s of input at the simulator's 200 Hz IMU and ground truth, 10 Hz
+  // frames (≈ 40 MB at most) wait while the process is behind on a loaded
+  // CPU (LCM's default queue, 30 messages, is 0.15 s of IMU): the demo's
+  // whole run, so what a process that fell behind still holds at the stop
+  // is drained or counted (Process, --drain). A queue that overflows loses
+  // messages silently; the stream's next message shows the gap, but not
+  // after its last one.
+  constexpr int kImuQueue = 24000, kFeaturesQueue = 1200;
   process.subscribe<imu_t>(
       process.channel("imu", "IMU"),
       [&](const imu_t& m) {
