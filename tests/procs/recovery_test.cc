@@ -88,16 +88,6 @@ struct Run {
   }
 };
 
-template <typename Node>
-void feed(Node& node, const std::vector<sim::SimEvent>& events) {
-  for (const auto& e : events) {
-    if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
-    if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
-    if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
-  }
-  node.flush();
-}
-
 Run run_vins(const std::vector<sim::SimEvent>& events, const VinsNodeOptions& options = vins_options()) {
   Run run;
   VinsNode node(
