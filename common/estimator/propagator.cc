@@ -84,6 +84,13 @@ ImuFeedStatus Propagator::feed_imu(const ImuData& imu) {
   return ImuFeedStatus::kAccepted;
 }
 
+bool Propagator::prepend(const ImuData& imu) {
+  if (!imu.w_IinI.allFinite() || !imu.a_IinI.allFinite()) return false;
+  if (!buffer_.empty() && imu.utime >= buffer_.front().utime) return false;
+  buffer_.push_front(imu);
+  return true;
+}
+
 void Propagator::clean_older_than(int64_t utime) {
   // Keep the last sample at or before utime for interpolation.
   while (buffer_.size() >= 2 && buffer_[1].utime <= utime) buffer_.pop_front();
@@ -219,20 +226,33 @@ bool Propagator::predict_interval(const ImuValue& x0, const ImuValue& x0_lin, in
     const double dt = utime_to_seconds(r1.utime - r0.utime);
     report->max_step_s = std::max(report->max_step_s, dt);
     if (dt > options_.max_gap_s) report->gap = true;
-    const Eigen::Vector3d w_m = 0.5 * (r0.w_IinI + r1.w_IinI);
-    const Eigen::Vector3d a_m = 0.5 * (r0.a_IinI + r1.a_IinI);
-    ImuValue xn;
-    if (Phi || Q) {
-      Matrix15d F, Qd;
-      predict_step(x, x_lin, w_m, a_m, dt, g, options_.noise, &xn, &F, &Qd);
-      if (Phi) *Phi = F * (*Phi);
-      if (Q) *Q = F * (*Q) * F.transpose() + Qd;
-    } else {
-      predict_step(x, x_lin, w_m, a_m, dt, g, options_.noise, &xn, nullptr, nullptr);
+    // A gap is crossed in sub-steps of interpolated readings with the gap
+    // noise added (ImuGapNoise); a regular step is one step.
+    const bool bridge = dt > options_.max_gap_s && options_.gap_noise.enabled();
+    const int n = bridge ? static_cast<int>(std::ceil(dt / options_.max_gap_s)) : 1;
+    ImuNoise noise = options_.noise;
+    if (bridge) {
+      noise.sigma_w = std::hypot(noise.sigma_w, options_.gap_noise.sigma_w);
+      noise.sigma_a = std::hypot(noise.sigma_a, options_.gap_noise.sigma_a);
     }
-    x = xn;
-    x_lin = xn;
-    ++report->steps;
+    for (int k = 0; k < n; ++k) {
+      const double s0 = static_cast<double>(k) / n, s1 = static_cast<double>(k + 1) / n, s = 0.5 * (s0 + s1);
+      const Eigen::Vector3d w_m = (1.0 - s) * r0.w_IinI + s * r1.w_IinI;
+      const Eigen::Vector3d a_m = (1.0 - s) * r0.a_IinI + s * r1.a_IinI;
+      const double h = dt / n;
+      ImuValue xn;
+      if (Phi || Q) {
+        Matrix15d F, Qd;
+        predict_step(x, x_lin, w_m, a_m, h, g, noise, &xn, &F, &Qd);
+        if (Phi) *Phi = F * (*Phi);
+        if (Q) *Q = F * (*Q) * F.transpose() + Qd;
+      } else {
+        predict_step(x, x_lin, w_m, a_m, h, g, noise, &xn, nullptr, nullptr);
+      }
+      x = xn;
+      x_lin = xn;
+      ++report->steps;
+    }
   }
   *x1 = x;
   if (report->extrapolated) report->message = "no IMU sample at or after the target time: last sample held";

@@ -51,10 +51,24 @@ struct ImuNoise {
   double sigma_ab{3.0e-3};      // accel bias random walk, m/s³/√Hz
 };
 
+/// The motion across an IMU gap (no samples, e.g. a sensor driver's
+/// restart) is unknown: the readings are taken as the linear interpolation
+/// of the samples around the gap plus white noise of these densities (the
+/// platform's unknown angular and linear acceleration over the gap), which
+/// the covariance takes on. 0: a gap is propagated with the sensor noise only.
+struct ImuGapNoise {
+  double sigma_w{0.0};  // rad/s/√Hz
+  double sigma_a{0.0};  // m/s²/√Hz
+  bool enabled() const { return sigma_w > 0.0 || sigma_a > 0.0; }
+};
+
 struct PropagatorOptions {
   ImuNoise noise;
   double gravity_magnitude{9.81};  // m/s²
   double max_gap_s{0.05};          // sample spacing above this is reported as a gap
+  /// With gap noise, a gap is integrated in steps of at most max_gap_s
+  /// (interpolated readings), each with the sensor plus the gap noise.
+  ImuGapNoise gap_noise;
   double buffer_s{5.0};            // IMU history kept behind the newest sample
 };
 
@@ -131,6 +145,10 @@ class Propagator {
   void clean_older_than(int64_t utime);
   /// Drops every buffered sample (the counts stay).
   void clear() { buffer_.clear(); }
+  /// Puts a sample older than every buffered one in front (a restored
+  /// state's last reading, so a gap after it is interpolated from it); false
+  /// if it is not older or not finite.
+  bool prepend(const ImuData& imu);
 
   /// The IMU prediction over [t0, t1] without touching a state: the mean x1
   /// from x0, and (if Phi/Q are given) the interval's Φ = ∏Φ_i and Q

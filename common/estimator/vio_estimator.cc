@@ -68,6 +68,8 @@ void VioOptions::validate() const {
   if (!(n.sigma_a > 0.0)) fail("imu.accelerometer_noise_density", "must be > 0");
   if (!(n.sigma_wb >= 0.0)) fail("imu.gyroscope_random_walk", "must be >= 0");
   if (!(n.sigma_ab >= 0.0)) fail("imu.accelerometer_random_walk", "must be >= 0");
+  if (!(propagator.gap_noise.sigma_w >= 0.0)) fail("imu_gap_noise.gyroscope_noise_density", "must be >= 0");
+  if (!(propagator.gap_noise.sigma_a >= 0.0)) fail("imu_gap_noise.accelerometer_noise_density", "must be >= 0");
   if (!(triangulation.min_depth > 0.0)) fail("triangulation.min_depth", "must be > 0");
   if (!(triangulation.max_depth > triangulation.min_depth)) fail("triangulation.max_depth", "must be > min_depth");
   if (!(triangulation.max_condition > 1.0)) fail("triangulation.max_condition", "must be > 1");
@@ -100,12 +102,13 @@ VioOptions VioOptions::from_config(const Config& estimator_cfg, const Config& ca
     c.check_keys(section, {"num_clones", "max_slam", "use_fej", "slam_representation", "max_slam_init_per_frame",
                            "slam_max_chi2_failures", "max_msckf_in_update", "msckf_chi2_multiplier",
                            "slam_chi2_multiplier", "use_stereo", "sigma_px", "gravity_magnitude", "max_imu_gap_s",
-                           "imu_buffer_s", "triangulation", "init", "divergence", "imu_noise"});
+                           "imu_buffer_s", "triangulation", "init", "divergence", "imu_noise", "imu_gap_noise"});
   }
   c.check_keys(s + "triangulation", {"min_depth", "max_depth", "max_condition", "max_iterations"});
   c.check_keys(s + "init", {"mode", "window_s", "max_accel_std", "sigma_theta_rp", "sigma_yaw", "sigma_p", "sigma_v",
                             "sigma_bg", "sigma_ba"});
   c.check_keys(s + "divergence", {"max_position_correction_m", "max_velocity_mps"});
+  c.check_keys(s + "imu_gap_noise", {"gyroscope_noise_density", "accelerometer_noise_density"});
   c.check_keys(s + "imu_noise", {"gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
                                  "accelerometer_random_walk"});
   read(c, s + "num_clones", &o.state.max_clones);
@@ -166,6 +169,8 @@ VioOptions VioOptions::from_config(const Config& estimator_cfg, const Config& ca
   read(c, s + "imu_noise.gyroscope_random_walk", &n.sigma_wb);
   read(c, s + "imu_noise.accelerometer_noise_density", &n.sigma_a);
   read(c, s + "imu_noise.accelerometer_random_walk", &n.sigma_ab);
+  read(c, s + "imu_gap_noise.gyroscope_noise_density", &o.propagator.gap_noise.sigma_w);
+  read(c, s + "imu_gap_noise.accelerometer_noise_density", &o.propagator.gap_noise.sigma_a);
 
   if (!calibration_cfg.has("cameras.cam0")) {
     throw ConfigError(calibration_cfg.source() + ": cameras.cam0: missing (camera calibration required)");

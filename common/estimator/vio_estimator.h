@@ -137,6 +137,9 @@ class VioEstimator {
   void reset();
   /// Also drops the buffered IMU data (a source whose clock moved).
   void clear_imu() { propagator_.clear(); }
+  /// An IMU reading older than every buffered one (a restored state's, see
+  /// checkpoint.h); false if it is not older.
+  bool prepend_imu(const ImuData& imu) { return propagator_.prepend(imu); }
 
   /// Called once per divergence detection (covariance non-finite or with a
   /// negative diagonal, non-finite state, too large a correction, too high a

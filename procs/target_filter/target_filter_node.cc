@@ -39,6 +39,7 @@ TargetFilterNodeOptions node_options_from_config(const Config& cfg) {
   options.publish_imu_rate = cfg.get_or<bool>("output.imu_rate", options.publish_imu_rate);
   target_options_from_config(cfg, &options);
   options.input = input_guard_options_from_config(vins);
+  check_bridge_options(options.input, options.vio, vins);
   return options;
 }
 
@@ -73,6 +74,7 @@ VinsNodeOptions vins_node_options(const TargetFilterNodeOptions& o) {
   v.publish_imu_rate = o.publish_imu_rate;
   v.max_queued_frames = o.max_queued_frames;
   v.input = o.input;
+  v.checkpoint_path = o.checkpoint_path;
   return v;
 }
 }  // namespace

@@ -52,6 +52,8 @@ struct TargetFilterNodeOptions {
   double ground_truth_buffer_s{2.0};
   /// Input guards (`input` section of the vins config), see VinsNodeOptions.
   InputGuardOptions input;
+  /// See VinsNodeOptions (the robot state only: the target is re-acquired).
+  std::string checkpoint_path;
 };
 
 /// The process's options from config/target_filter.yaml:
@@ -88,6 +90,8 @@ class TargetFilterNode {
   void on_ground_truth(const GroundTruth& truth);
   /// Processes every queued frame with the IMU data there is.
   void flush();
+  /// The robot part (VinsNode): resets, bridged gaps, restore.
+  const VinsNode& vins() const { return vins_; }
 
   bool initialized() const { return vins_.initialized(); }
   bool target_initialized() const { return filter_ && filter_->initialized(); }

@@ -19,11 +19,14 @@ int run(int argc, const char* const* argv) {
                          /*config_required=*/true);
   process.args().add_option("perturb-seed", "N",
                             "start from ground truth perturbed with this seed (overrides init.perturb_seed)");
+  process.args().add_option("checkpoint", "PATH",
+                            "robot state file written per update; a restart goes on from it if recent (input.bridge_max_gap_s)");
   process.args().add_option("max-wait", "SECONDS",
                             "process a queued camera frame after this much wall time without IMU", "0.5");
   if (!process.init(argc, argv)) return 0;
 
   vimot::VinsNodeOptions options = vimot::vins_node_options_from_config(process.config());
+  if (process.args().given("checkpoint")) options.checkpoint_path = process.args().get("checkpoint");
   if (process.args().given("perturb-seed")) {
     options.perturb_seed = static_cast<uint64_t>(process.args().get_int("perturb-seed"));
   }

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
+#include "common/estimator/checkpoint.h"
 #include "common/estimator/initial_estimate.h"
 #include "common/estimator/nav_state_of.h"
 #include "common/estimator/vins_config.h"
@@ -17,6 +19,7 @@ void InputGuardOptions::validate() const {
   if (!(max_normalized > 0.0)) throw std::invalid_argument("max_normalized: must be > 0");
   if (!(max_pixels_outside >= 0.0)) throw std::invalid_argument("max_pixels_outside: must be >= 0");
   if (!(max_imu_gap_s > 0.0)) throw std::invalid_argument("max_imu_gap_s: must be > 0");
+  if (!(bridge_max_gap_s >= 0.0)) throw std::invalid_argument("bridge_max_gap_s: must be >= 0");
   if (max_rejected_frames < 1) throw std::invalid_argument("max_rejected_frames: must be >= 1");
   if (consistency_window < 1) throw std::invalid_argument("consistency_window: must be >= 1");
   if (consistency_min_tests < 1) throw std::invalid_argument("consistency_min_tests: must be >= 1");
@@ -32,7 +35,8 @@ InputGuardOptions input_guard_options_from_config(const Config& cfg) {
   InputGuardOptions o;
   if (!cfg.has("input")) return o;
   cfg.check_keys("input", {"imu", "features", "ground_truth", "source_reset_after", "max_gyro_radps",
-                           "max_accel_mps2", "max_normalized", "max_pixels_outside", "max_imu_gap_s", "max_rejected_frames", "consistency_window",
+                           "max_accel_mps2", "max_normalized", "max_pixels_outside", "max_imu_gap_s", "bridge_max_gap_s",
+                           "max_rejected_frames", "consistency_window",
                            "consistency_min_tests", "max_chi2_failure_fraction", "max_quat_norm_error"});
   const int reset_after = cfg.get_or<int>("input.source_reset_after", o.imu.reset_after);
   const std::pair<const char*, StreamGuardOptions*> streams[] = {
@@ -53,6 +57,7 @@ InputGuardOptions input_guard_options_from_config(const Config& cfg) {
   o.max_normalized = cfg.get_or<double>("input.max_normalized", o.max_normalized);
   o.max_pixels_outside = cfg.get_or<double>("input.max_pixels_outside", o.max_pixels_outside);
   o.max_imu_gap_s = cfg.get_or<double>("input.max_imu_gap_s", o.max_imu_gap_s);
+  o.bridge_max_gap_s = cfg.get_or<double>("input.bridge_max_gap_s", o.bridge_max_gap_s);
   o.max_rejected_frames = cfg.get_or<int>("input.max_rejected_frames", o.max_rejected_frames);
   o.consistency_window = cfg.get_or<int>("input.consistency_window", o.consistency_window);
   o.consistency_min_tests = cfg.get_or<int>("input.consistency_min_tests", o.consistency_min_tests);
@@ -90,7 +95,14 @@ VinsNodeOptions vins_node_options_from_config(const Config& cfg) {
   options.imu_rate_every = cfg.get_or<int>("output.imu_rate_every", options.imu_rate_every);
   if (options.imu_rate_every < 1) cfg.fail("output.imu_rate_every", "must be >= 1");
   options.input = input_guard_options_from_config(cfg);
+  check_bridge_options(options.input, options.vio, cfg);
   return options;
+}
+
+void check_bridge_options(const InputGuardOptions& input, const estimator::VioOptions& vio, const Config& cfg) {
+  if (input.bridge_max_gap_s > 0.0 && !vio.propagator.gap_noise.enabled()) {
+    cfg.fail("input.bridge_max_gap_s", "bridging a gap needs estimator.imu_gap_noise (the unknown motion over it)");
+  }
 }
 
 VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, EventCallback on_event)
@@ -102,6 +114,9 @@ VinsNode::VinsNode(const VinsNodeOptions& options, StateCallback on_state, Event
       frame_guard_("FEATURES", options.input.features),
       truth_guard_("GROUND_TRUTH", options.input.ground_truth) {
   options_.input.validate();
+  if (options_.input.bridge_max_gap_s > 0.0 && !options_.vio.propagator.gap_noise.enabled()) {
+    throw std::invalid_argument("input.bridge_max_gap_s needs estimator.imu_gap_noise");
+  }
 }
 
 void VinsNode::set_frame_hooks(std::function<void(const CameraFrame&)> before_frame,
@@ -153,7 +168,20 @@ bool VinsNode::admit(StreamGuard& guard, int64_t utime) {
         say(NodeEvent::Kind::kInfo, c.message);  // not an input of the estimate: only its clock restarts
         return true;
       }
-      reset_estimate(c.message, /*clean_clock=*/true);
+      // A short outage forward (the source restarted on its own schedule):
+      // the guard's clock moved on, the estimate is propagated across it.
+      std::string why = c.message;
+      if (estimator_.initialized() && options_.input.bridge_max_gap_s > 0.0) {
+        const int64_t last = &guard == &imu_guard_ ? estimator_.propagator().latest_utime() : last_frame_utime_;
+        const double gap_s = 1e-6 * static_cast<double>(utime - last);
+        if (last >= 0 && gap_s > 0.0 && gap_s <= options_.input.bridge_max_gap_s) {
+          say(NodeEvent::Kind::kInfo, c.message + ": an outage of " + std::to_string(gap_s) +
+                                          " s, the estimate is kept (bridged at the next frame)");
+          return true;
+        }
+        why += " (longer than input.bridge_max_gap_s " + std::to_string(options_.input.bridge_max_gap_s) + " s)";
+      }
+      reset_estimate(why, /*clean_clock=*/true);
       guard.check(utime);  // the new clock starts here
       return true;
   }
@@ -189,6 +217,7 @@ void VinsNode::on_imu_checked(const ImuData& imu) {
           std::string("IMU sample at utime ") + std::to_string(imu.utime) + ": " + estimator::to_string(status));
       return;
   }
+  try_restore(imu.utime);
   process_ready_frames(imu.utime);
   if (options_.publish_imu_rate && queued_frames_.empty()) publish_propagated(imu.utime);
 }
@@ -294,7 +323,8 @@ bool VinsNode::on_ground_truth(const GroundTruth& message, GroundTruth* accepted
     if (!admit(truth_guard_, truth.utime) || !check_ground_truth(&truth)) return;
     usable = true;
     if (accepted != nullptr) *accepted = truth;
-    if (starting) initialise_from(truth);
+    if (starting) try_restore(truth.utime);
+    if (starting && !estimator_.initialized()) initialise_from(truth);
   });
   return usable;
 }
@@ -303,6 +333,52 @@ void VinsNode::initialise_from(const GroundTruth& truth) {
   const estimator::InitialEstimate init = estimator::initial_estimate(truth, options_.vio, options_.perturb_seed);
   estimator_.initialize(init.value, truth.utime, init.P0);
   say(NodeEvent::Kind::kInfo, "initialised from ground truth at utime " + std::to_string(truth.utime));
+}
+
+void VinsNode::try_restore(int64_t input_utime) {
+  if (restore_tried_ || options_.checkpoint_path.empty() || estimator_.initialized()) return;
+  restore_tried_ = true;
+  estimator::RobotCheckpoint c;
+  std::string why;
+  if (!estimator::read_checkpoint(options_.checkpoint_path, &c, &why)) {
+    // None yet is a normal first start; an unreadable one is a fault.
+    const bool absent = why.rfind("no checkpoint", 0) == 0;
+    say(absent ? NodeEvent::Kind::kInfo : NodeEvent::Kind::kError,
+        why + "; starting " + (options_.init_from_ground_truth ? "from ground truth" : "at rest"));
+    return;
+  }
+  const double age_s = 1e-6 * static_cast<double>(input_utime - c.state.utime);
+  if (!(age_s >= 0.0 && age_s <= options_.input.bridge_max_gap_s)) {
+    std::ostringstream msg;
+    msg << "checkpoint " << options_.checkpoint_path << " rejected: stale, its utime " << c.state.utime << " is "
+        << age_s << " s before the input (limit input.bridge_max_gap_s " << options_.input.bridge_max_gap_s
+        << " s); starting " << (options_.init_from_ground_truth ? "from ground truth" : "at rest");
+    say(NodeEvent::Kind::kInfo, msg.str());
+    return;
+  }
+  estimator::restore(c, &estimator_);
+  restored_ = true;
+  std::ostringstream msg;
+  msg << "restored from checkpoint " << options_.checkpoint_path << " at utime " << c.state.utime << ", " << age_s
+      << " s before the input: bridging the gap";
+  say(NodeEvent::Kind::kInfo, msg.str());
+}
+
+void VinsNode::write_checkpoint() {
+  if (options_.checkpoint_path.empty()) return;
+  std::string why;
+  if (estimator::write_checkpoint(options_.checkpoint_path, estimator::checkpoint_of(estimator_), &why)) return;
+  if (!std::exchange(checkpoint_failed_, true)) say(NodeEvent::Kind::kError, why + " (said once)");
+}
+
+bool VinsNode::bridges(double gap_s, const std::string& what) {
+  if (!(gap_s <= options_.input.bridge_max_gap_s)) return false;
+  ++bridged_gaps_;
+  std::ostringstream msg;
+  msg << what << ": bridged, the estimate kept and propagated across the " << gap_s
+      << " s gap (input.bridge_max_gap_s " << options_.input.bridge_max_gap_s << " s)";
+  say(NodeEvent::Kind::kInfo, msg.str());
+  return true;
 }
 
 void VinsNode::process_ready_frames(int64_t latest_imu_utime) {
@@ -332,13 +408,18 @@ void VinsNode::process_frame(const CameraFrame& frame) {
     case estimator::FrameStatus::kProcessed: {
       const estimator::PropagationReport& prop = estimator_.last_propagation();
       if (prop.max_step_s > options_.input.max_imu_gap_s) {
-        reset_estimate("frame at utime " + std::to_string(frame.utime) + " propagated across an IMU gap of " +
-                           std::to_string(prop.max_step_s) + " s (limit " +
-                           std::to_string(options_.input.max_imu_gap_s) + " s)",
-                       /*clean_clock=*/false);
-        return;
+        const std::string gap = "frame at utime " + std::to_string(frame.utime) + " propagated across an IMU gap of " +
+                                std::to_string(prop.max_step_s) + " s";
+        if (!bridges(prop.max_step_s, gap)) {
+          reset_estimate(gap + " (limit " + std::to_string(options_.input.max_imu_gap_s) +
+                             " s; longer than input.bridge_max_gap_s " +
+                             std::to_string(options_.input.bridge_max_gap_s) + " s)",
+                         /*clean_clock=*/false);
+          return;
+        }
       }
       publish_updated();
+      write_checkpoint();
       if (after_update_) after_update_();
       check_consistency();
       return;

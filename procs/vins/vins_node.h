@@ -52,6 +52,14 @@ struct InputGuardOptions {
   /// frames continue), or propagated across a longer IMU gap: reset. Also
   /// how close to the IMU clock a ground truth must be to start from.
   double max_imu_gap_s{0.5};
+  /// An outage of all input (e.g. the sensor driver restarted) up to this
+  /// long is bridged instead of reset: the estimate, clones and landmarks
+  /// are kept and propagated across it with the estimator's IMU gap noise
+  /// (estimator.imu_gap_noise, required), and the first frames after it
+  /// re-lock on the landmarks; an inconsistent result is caught by the χ²
+  /// window below. Also the oldest checkpoint a start restores from.
+  /// 0: every gap above max_imu_gap_s resets.
+  double bridge_max_gap_s{0.0};
   /// Consecutive frames the estimator rejects as not after its state time
   /// (its clock is wrong, e.g. started from a future ground truth): reset.
   int max_rejected_frames{3};
@@ -94,12 +102,21 @@ struct VinsNodeOptions {
   /// anyway (IMU stream stalled) — bounded memory and latency.
   int max_queued_frames{5};
   InputGuardOptions input;
+  /// If set: the robot state is written there after every update
+  /// (common/estimator/checkpoint.h), and a start goes on from it when it
+  /// is at most input.bridge_max_gap_s older than the first input, bridging
+  /// the gap (a respawned process). Empty: no checkpoint.
+  std::string checkpoint_path;
 };
 
 /// The process's options from a vins config (config/vins.yaml, layout in
 /// common/estimator/vins_config.h): estimator, init, output.imu_rate.
 /// Throws ConfigError naming the file and key, also for an unknown key.
 VinsNodeOptions vins_node_options_from_config(const Config& cfg);
+
+/// ConfigError if input.bridge_max_gap_s is set without the estimator's
+/// IMU gap noise (a bridge must grow the covariance).
+void check_bridge_options(const InputGuardOptions& input, const estimator::VioOptions& vio, const Config& cfg);
 
 class VinsNode {
  public:
@@ -124,6 +141,10 @@ class VinsNode {
   bool initialized() const { return estimator_.initialized(); }
   int64_t frames_processed() const { return estimator_.frames_processed(); }
   int64_t resets() const { return resets_; }
+  /// Input outages propagated across instead of reset (bridge_max_gap_s).
+  int64_t bridged_gaps() const { return bridged_gaps_; }
+  /// True once the estimate was restored from the checkpoint.
+  bool restored() const { return restored_; }
   /// Validates a ground-truth message's values in place (quaternions
   /// normalised); false, said as dropped, if it is unusable.
   bool check_ground_truth(GroundTruth* truth);
@@ -153,6 +174,12 @@ class VinsNode {
   void on_frame_checked(const CameraFrame& frame);
   void check_consistency();
   void initialise_from(const GroundTruth& truth);
+  /// At the first input only: restores the checkpoint if it is usable and
+  /// at most bridge_max_gap_s before `input_utime`; says what it did.
+  void try_restore(int64_t input_utime);
+  void write_checkpoint();
+  /// True (said) if a step of `gap_s` forward in the input is bridged.
+  bool bridges(double gap_s, const std::string& what);
 
   VinsNodeOptions options_;
   estimator::VioEstimator estimator_;
@@ -163,6 +190,10 @@ class VinsNode {
   std::deque<CameraFrame> queued_frames_;
   int64_t last_frame_utime_{-1};
   int64_t resets_{0};
+  int64_t bridged_gaps_{0};
+  bool restore_tried_{false};
+  bool restored_{false};
+  bool checkpoint_failed_{false};  // said once
   StreamGuard imu_guard_;
   StreamGuard frame_guard_;
   StreamGuard truth_guard_;

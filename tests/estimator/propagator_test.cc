@@ -245,3 +245,45 @@ TEST_CASE("Noise-free propagation follows a constant-rate circular motion exactl
   CHECK((xe.v_IinG - xt.v_IinG).norm() < 1e-3);
   CHECK(rotation_angle_between(quat_to_rot(xe.q_GtoI), quat_to_rot(xt.q_GtoI)) < 1e-9);
 }
+
+TEST_CASE("An IMU gap with gap noise: same mean for steady readings, covariance of the unknown motion", "[propagator]") {
+  // At rest, level: the readings are gravity's specific force, before and
+  // after a 1.2 s gap. Mean: still at rest (interpolated readings are the
+  // same); covariance over the gap, to first order: attitude σ_w² T per
+  // axis, velocity σ_a² T, position σ_a² T³/3 (white accel noise
+  // integrated twice), plus tilt × gravity terms in the horizontal axes.
+  PropagatorOptions o;
+  o.gap_noise.sigma_w = 0.02;
+  o.gap_noise.sigma_a = 0.2;
+  Propagator with_gap(o);
+  Propagator without(PropagatorOptions{});
+  const Eigen::Vector3d f(0.0, 0.0, 9.81);
+  for (int64_t t : {int64_t{1'000'000}, int64_t{1'005'000}, int64_t{2'205'000}, int64_t{2'210'000}}) {
+    ImuData s;
+    s.utime = t;
+    s.a_IinI = f;
+    with_gap.feed_imu(s);
+    without.feed_imu(s);
+  }
+  ImuValue x0;
+  x0.q_GtoI = Eigen::Vector4d(0.0, 0.0, 0.0, 1.0);
+  ImuValue x1, y1;
+  Matrix15d Phi, Q, Phi0, Q0;
+  PropagationReport r, r0;
+  REQUIRE(with_gap.predict_interval(x0, x0, 1'000'000, 2'210'000, &x1, &Phi, &Q, &r));
+  REQUIRE(without.predict_interval(x0, x0, 1'000'000, 2'210'000, &y1, &Phi0, &Q0, &r0));
+  CHECK(r.gap);
+  CHECK(r.max_step_s == Approx(1.2));
+  CHECK(r.steps > r0.steps);  // sub-steps across the gap
+  CHECK((x1.to_vector() - y1.to_vector()).cwiseAbs().maxCoeff() < 1e-12);
+  const double T = 1.2;
+  const double var_th = o.gap_noise.sigma_w * o.gap_noise.sigma_w * T;
+  const double var_v = o.gap_noise.sigma_a * o.gap_noise.sigma_a * T;
+  const double var_p = o.gap_noise.sigma_a * o.gap_noise.sigma_a * T * T * T / 3.0;
+  // Vertical axis (z): no tilt coupling with gravity along z.
+  CHECK(Q(2, 2) == Approx(var_th).epsilon(0.05));
+  CHECK(Q(8, 8) == Approx(var_v).epsilon(0.05));
+  CHECK(Q(5, 5) == Approx(var_p).epsilon(0.05));
+  // Without gap noise the gap adds only the sensor's (orders smaller).
+  CHECK(Q0(5, 5) < 1e-3 * var_p);
+}

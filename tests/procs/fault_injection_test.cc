@@ -330,15 +330,20 @@ TEST_CASE("an IMU gap of 2 s while frames continue is said and reset, then recov
   check_reset_and_recovered(run);
 }
 
-TEST_CASE("all input lost for 1 s (a stalled process) is counted, then reset or absorbed", "[fault]") {
+TEST_CASE("all input lost for 1 s (a stalled process) is counted and bridged", "[fault]") {
   const Run run = run_vins(
       inject([&](Timed& te) { return std::holds_alternative<GroundTruth>(te.event) || te.sim_utime >= kFault + 1'000'000; }));
   CHECK(run.lost > 0);
-  if (run.resets > 0) {
-    check_reset_and_recovered(run);
-  } else {
-    check_absorbed(run, kFault + 1'000'000 + kSettle);
-  }
+  // input.bridge_max_gap_s: kept and propagated across, not reset. A second
+  // without input leaves an offset (here 1.5 cm on a 2 cm RMS: the map is
+  // 3 s old), so the bar is the undisturbed run's (tests/procs/recovery_test.cc
+  // checks consistency and the relative accuracy).
+  CHECK(run.resets == 0);
+  bool bridged = false;
+  for (const auto& e : run.events) bridged = bridged || e.message.find("bridged, the estimate kept") != std::string::npos;
+  CHECK(bridged);
+  CHECK(run.states_from(kFault + 1'000'000 + kSettle) >= clean_run().states_from(kFault + 1'000'000 + kSettle) - 2);
+  CHECK(run.rms_from(kFault + 1'000'000 + kSettle) < 0.1);
 }
 
 TEST_CASE("lost messages are counted exactly against the expected rate", "[fault]") {

@@ -25,6 +25,17 @@ inline std::vector<sim::SimEvent> simulate(double duration) {
   return events;
 }
 
+/// Feeds `events` to a node (VinsNode, TargetFilterNode) in order, then flushes it.
+template <typename Node>
+void feed(Node& node, const std::vector<sim::SimEvent>& events) {
+  for (const auto& e : events) {
+    if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
+    if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
+    if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
+  }
+  node.flush();
+}
+
 /// Every camera frame but the first moved before the last 5 IMU samples up
 /// to its time, as if it arrived early on the network (the first stays after
 /// the ground truth that initialises the filter).

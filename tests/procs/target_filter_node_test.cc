@@ -47,16 +47,6 @@ TargetFilterNodeOptions node_options() {
   return o;
 }
 
-template <typename Node>
-void feed(Node& node, const std::vector<sim::SimEvent>& events) {
-  for (const auto& e : events) {
-    if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
-    if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
-    if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
-  }
-  node.flush();
-}
-
 Outputs run_node(const std::vector<sim::SimEvent>& events, const TargetFilterNodeOptions& options) {
   Outputs out;
   TargetFilterNode::Callbacks cb;
