@@ -8,7 +8,10 @@
 // and left to right for stereo points. Target features: ORB inside the box
 // (orb_features.h), matched by descriptor frame to frame and left to right;
 // a new target track is matched against the stored target points
-// (target_point_store.h) and re-uses the id of the point it re-finds. Every
+// (target_point_store.h) and re-uses the id of the point it re-finds.
+// Optionally (target.frame_to_frame / stereo klt, anchor_align) target
+// points are followed by KLT, anchored, and matched left to right by KLT,
+// ORB only detecting new ones and closing loops. Every
 // match set (per camera frame to frame, stereo; static and target apart) is
 // cleaned by 8-point RANSAC (epipolar_ransac.h).
 //
