@@ -102,15 +102,17 @@ bool FeatureTracker::usable(int cam, const cv::Point2f& px, const std::optional<
 
 std::vector<FeatureTracker::Point> FeatureTracker::klt(const std::vector<cv::Mat>& from_pyr, int to_cam,
                                                        const std::vector<cv::Mat>& to_pyr,
-                                                       const std::vector<Point>& points,
-                                                       const std::optional<Box>& to_box) const {
+                                                       const std::vector<Point>& points, cv::Point2f shift,
+                                                       const PixelTest& keep) const {
   std::vector<Point> out;
   if (points.empty()) return out;
   const StaticTrackOptions& o = options_.static_tracks;
   std::vector<cv::Point2f> from, to;
   from.reserve(points.size());
-  for (const Point& p : points) from.push_back(p.pixel);
-  to = from;  // the initial guess: no motion (frame to frame) or no disparity (stereo)
+  for (const Point& p : points) {
+    from.push_back(p.pixel);
+    to.push_back(p.pixel + shift);
+  }
   std::vector<uint8_t> status;
   std::vector<float> error;
   cv::calcOpticalFlowPyrLK(
@@ -118,13 +120,9 @@ std::vector<FeatureTracker::Point> FeatureTracker::klt(const std::vector<cv::Mat
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations, o.klt_epsilon),
       cv::OPTFLOW_USE_INITIAL_FLOW);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!status[i] || !usable(to_cam, to[i], to_box)) continue;
-    Point p;
-    p.id = points[i].id;
+    if (!status[i] || !keep(to[i])) continue;
+    Point p = points[i];
     p.pixel = to[i];
-    p.born_frame = points[i].born_frame;
-    p.anchor = points[i].anchor;
-    p.affine = points[i].affine;
     if (normalize(to_cam, &p)) out.push_back(p);
   }
   return out;
@@ -139,33 +137,37 @@ bool FeatureTracker::anchor(int cam, Point* p) const {
   return true;
 }
 
-void FeatureTracker::align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const {
+std::optional<FeatureTracker::Point> FeatureTracker::aligned(int cam, const Point& p) const {
   const StaticTrackOptions& o = options_.static_tracks;
-  const cv::Mat& image = pyramid_[static_cast<std::size_t>(cam)][0];
-  const auto max_correction2 = static_cast<float>(o.anchor_max_correction_px * o.anchor_max_correction_px);
+  const std::optional<AnchorPatch::Alignment> a =
+      p.anchor->align(pyramid_[static_cast<std::size_t>(cam)][0], p.pixel, p.affine, o.klt_max_iterations,
+                      static_cast<float>(o.klt_epsilon));
+  if (!a || a->zncc < o.anchor_min_zncc) return std::nullopt;
+  const cv::Point2f correction = a->pixel - p.pixel;
+  if (correction.dot(correction) > o.anchor_max_correction_px * o.anchor_max_correction_px) return std::nullopt;
+  Point q = p;
+  q.pixel = a->pixel;
+  q.affine = a->affine;
+  if (!normalize(cam, &q)) return std::nullopt;
+  const Eigen::Vector2f scale = Eigen::JacobiSVD<Eigen::Matrix2f>(q.affine).singularValues();
+  const auto limit = static_cast<float>(o.anchor_max_scale);
+  // Far from the anchor's scale the affine model no longer describes the
+  // patch (perspective, resampling): the current patch, at the aligned
+  // position, becomes the anchor. The error made so far is kept, but it
+  // grows only at these rare steps, not every frame.
+  if (scale(0) > limit || scale(1) < 1.0f / limit) {
+    Point fresh = q;
+    if (anchor(cam, &fresh)) q = fresh;
+  }
+  return q;
+}
+
+void FeatureTracker::align_to_anchors(int cam, const PixelTest& keep, std::vector<Point>* points) const {
   std::vector<Point> kept;
   kept.reserve(points->size());
-  for (Point& p : *points) {
-    const std::optional<AnchorPatch::Alignment> a = p.anchor->align(
-        image, p.pixel, p.affine, o.klt_max_iterations, static_cast<float>(o.klt_epsilon));
-    if (!a || a->zncc < o.anchor_min_zncc) continue;
-    const cv::Point2f correction = a->pixel - p.pixel;
-    if (correction.dot(correction) > max_correction2 || !usable(cam, a->pixel, box)) continue;
-    Point q = p;
-    q.pixel = a->pixel;
-    q.affine = a->affine;
-    if (!normalize(cam, &q)) continue;
-    const Eigen::Vector2f scale = Eigen::JacobiSVD<Eigen::Matrix2f>(q.affine).singularValues();
-    const auto limit = static_cast<float>(o.anchor_max_scale);
-    // Far from the anchor's scale the affine model no longer describes the
-    // patch (perspective, resampling): the current patch, at the aligned
-    // position, becomes the anchor. The error made so far is kept, but it
-    // grows only at these rare steps, not every frame.
-    if (scale(0) > limit || scale(1) < 1.0f / limit) {
-      Point fresh = q;
-      if (anchor(cam, &fresh)) q = fresh;
-    }
-    kept.push_back(std::move(q));
+  for (const Point& p : *points) {
+    std::optional<Point> q = aligned(cam, p);
+    if (q && keep(q->pixel)) kept.push_back(std::move(*q));
   }
   points->swap(kept);
 }
@@ -175,14 +177,15 @@ void FeatureTracker::track_static_temporal(int cam, const std::optional<Box>& bo
   if (prev_pyramid_[c].empty() || static_[c].empty()) return;
   std::unordered_map<int64_t, Eigen::Vector2d> before;
   for (const Point& p : static_[c]) before.emplace(p.id, p.normalized);
-  std::vector<Point> tracked = klt(prev_pyramid_[c], cam, pyramid_[c], static_[c], box);
+  const PixelTest keep = [&](const cv::Point2f& px) { return usable(cam, px, box); };
+  std::vector<Point> tracked = klt(prev_pyramid_[c], cam, pyramid_[c], static_[c], {}, keep);
   const int max_age = options_.static_tracks.max_track_frames;
   if (max_age > 0) {
     tracked.erase(std::remove_if(tracked.begin(), tracked.end(),
                                  [&](const Point& p) { return frame_index_ - p.born_frame >= max_age; }),
                   tracked.end());
   }
-  if (options_.static_tracks.anchor_align) align_to_anchors(cam, box, &tracked);
+  if (options_.static_tracks.anchor_align) align_to_anchors(cam, keep, &tracked);
   std::vector<Eigen::Vector2d> a, b;
   for (const Point& p : tracked) {
     a.push_back(before.at(p.id));
@@ -215,8 +218,6 @@ void FeatureTracker::detect_static(const std::optional<Box>& box) {
 void FeatureTracker::match_static_stereo(const std::optional<Box>& box_right) {
   std::vector<Point>& left = static_[0];
   std::vector<Point>& right = static_[1];
-  std::unordered_map<int64_t, std::size_t> left_of;
-  for (std::size_t i = 0; i < left.size(); ++i) left_of.emplace(left[i].id, i);
   // Right points whose left partner was lost stay right-only tracks. Only
   // this frame's new left corners are looked for in the right image:
   // retrying every left-only track each frame cost ~2 ms per EuRoC pair for
@@ -226,13 +227,26 @@ void FeatureTracker::match_static_stereo(const std::optional<Box>& box_right) {
   for (const Point& p : left) {
     if (p.id >= first_new_id_) fresh.push_back(p);
   }
-  std::vector<Point> found = klt(pyramid_[0], 1, pyramid_[1], fresh, box_right);
+  std::vector<Point> found =
+      klt(pyramid_[0], 1, pyramid_[1], fresh, {}, [&](const cv::Point2f& px) { return usable(1, px, box_right); });
   for (Point& p : found) {
     // A right track is anchored in the right image where it was matched.
     if (!options_.static_tracks.anchor_align || anchor(1, &p)) right.push_back(std::move(p));
   }
 
+  const std::vector<bool> keep = stereo_inliers(left, right);
+  std::vector<Point> kept;
+  kept.reserve(right.size());
+  for (std::size_t j = 0; j < right.size(); ++j) {
+    if (keep[j]) kept.push_back(right[j]);
+  }
+  right.swap(kept);
+}
+
+std::vector<bool> FeatureTracker::stereo_inliers(const std::vector<Point>& left, const std::vector<Point>& right) {
   // One RANSAC over every stereo pair, continuing and new.
+  std::unordered_map<int64_t, std::size_t> left_of;
+  for (std::size_t i = 0; i < left.size(); ++i) left_of.emplace(left[i].id, i);
   std::vector<std::size_t> right_index;
   std::vector<Eigen::Vector2d> a, b;
   for (std::size_t j = 0; j < right.size(); ++j) {
@@ -247,53 +261,80 @@ void FeatureTracker::match_static_stereo(const std::optional<Box>& box_right) {
   for (std::size_t k = 0; k < right_index.size(); ++k) {
     if (!in[k]) keep[right_index[k]] = false;
   }
-  std::vector<Point> kept;
-  kept.reserve(right.size());
-  for (std::size_t j = 0; j < right.size(); ++j) {
-    if (keep[j]) kept.push_back(right[j]);
-  }
-  right.swap(kept);
+  return keep;
 }
 
 std::vector<FeatureTracker::TargetPoint> FeatureTracker::klt_target(int cam, const Box& box) {
   const auto c = static_cast<std::size_t>(cam);
   const std::vector<TargetPoint>& prev = target_[c];
   if (prev.empty() || prev_pyramid_[c].empty()) return {};
-  const StaticTrackOptions& o = options_.static_tracks;
   cv::Point2f shift(0.f, 0.f);
   if (prev_box_[c]) {
     shift = cv::Point2f(static_cast<float>(box.center_u() - prev_box_[c]->center_u()),
                         static_cast<float>(box.center_v() - prev_box_[c]->center_v()));
   }
-  std::vector<cv::Point2f> from, to;
+  std::vector<Point> from;
+  std::unordered_map<int64_t, const TargetPoint*> prev_of;
   for (const TargetPoint& t : prev) {
-    from.push_back(t.point.pixel);
-    to.push_back(t.point.pixel + shift);
+    from.push_back(t.point);
+    prev_of.emplace(t.point.id, &t);
   }
-  std::vector<uint8_t> status;
-  std::vector<float> error;
-  cv::calcOpticalFlowPyrLK(
-      prev_pyramid_[c], pyramid_[c], from, to, status, error, cv::Size(o.klt_window_px, o.klt_window_px),
-      o.klt_pyramid_levels,
-      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations, o.klt_epsilon),
-      cv::OPTFLOW_USE_INITIAL_FLOW);
+  const PixelTest keep = [&](const cv::Point2f& px) { return in_box(cam, px, box); };
+  std::vector<Point> tracked = klt(prev_pyramid_[c], cam, pyramid_[c], from, shift, keep);
+  if (options_.target.anchor_align) align_to_anchors(cam, keep, &tracked);
   std::vector<Eigen::Vector2d> a, b;
-  std::vector<TargetPoint> out;
-  for (std::size_t i = 0; i < prev.size(); ++i) {
-    if (!status[i] || !box.contains(to[i].x, to[i].y)) continue;
-    TargetPoint t = prev[i];
-    t.point.pixel = to[i];
-    if (!normalize(cam, &t.point)) continue;
-    a.push_back(prev[i].point.normalized);
-    b.push_back(t.point.normalized);
-    out.push_back(t);
+  for (const Point& p : tracked) {
+    a.push_back(prev_of.at(p.id)->point.normalized);
+    b.push_back(p.normalized);
   }
   const std::vector<bool> in = ransac_.inliers(a, b, focal(cam, cam));
   std::vector<TargetPoint> kept;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (in[i]) kept.push_back(out[i]);
+  for (std::size_t i = 0; i < tracked.size(); ++i) {
+    if (!in[i]) continue;
+    TargetPoint t = *prev_of.at(tracked[i].id);
+    t.point = tracked[i];
+    kept.push_back(t);
   }
   return kept;
+}
+
+bool FeatureTracker::in_box(int cam, const cv::Point2f& px, const Box& box) const {
+  return box.contains(px.x, px.y) && cameras_[static_cast<std::size_t>(cam)].in_image(Eigen::Vector2d(px.x, px.y), 0.0);
+}
+
+void FeatureTracker::match_target_stereo_klt(const Box& box_right, std::vector<std::vector<TargetPoint>>* cur) {
+  std::vector<TargetPoint>& left = (*cur)[0];
+  std::vector<TargetPoint>& right = (*cur)[1];
+  std::set<int64_t> paired;
+  for (const TargetPoint& t : right) paired.insert(t.point.id);
+  std::vector<Point> lone;
+  std::unordered_map<int64_t, const Descriptor*> descriptor_of;
+  for (const TargetPoint& t : left) {
+    if (paired.count(t.point.id) != 0) continue;
+    lone.push_back(t.point);
+    descriptor_of.emplace(t.point.id, &t.descriptor);
+  }
+  // Every left-only point is looked for, not only new ones: a box holds few
+  // points (<= num_features), and a target point lost on the right by the
+  // target's own occlusion comes back when it turns.
+  const std::vector<Point> found = klt(pyramid_[0], 1, pyramid_[1], lone, {},
+                                       [&](const cv::Point2f& px) { return in_box(1, px, box_right); });
+  for (const Point& p : found) {
+    TargetPoint t;
+    t.point = p;
+    t.descriptor = *descriptor_of.at(p.id);
+    if (options_.target.anchor_align && !anchor(1, &t.point)) continue;
+    right.push_back(t);
+  }
+  std::vector<Point> l, r;
+  for (const TargetPoint& t : left) l.push_back(t.point);
+  for (const TargetPoint& t : right) r.push_back(t.point);
+  const std::vector<bool> keep = stereo_inliers(l, r);
+  std::vector<TargetPoint> kept;
+  for (std::size_t j = 0; j < right.size(); ++j) {
+    if (keep[j]) kept.push_back(right[j]);
+  }
+  right.swap(kept);
 }
 
 void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes) {
@@ -305,6 +346,7 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
     if (!boxes[c]) continue;
     const int cam = static_cast<int>(c);
     if (o.klt()) cur[c] = klt_target(cam, *boxes[c]);
+    if (c == 1 && o.stereo_klt()) continue;  // right points come from the left ones (match_target_stereo_klt)
     const std::size_t tracked = cur[c].size();
     const double min_d2 = o.min_distance_px * o.min_distance_px;
     for (const OrbFeature& f : orb_.detect(images[c], *boxes[c])) {
@@ -318,7 +360,9 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
       TargetPoint t;
       t.point.pixel = f.pixel;
       t.descriptor = f.descriptor;
-      if (normalize(cam, &t.point)) cur[c].push_back(t);
+      if (!normalize(cam, &t.point)) continue;
+      if (o.anchor_align && !anchor(cam, &t.point)) continue;
+      cur[c].push_back(t);
     }
     for (const TargetPoint& t : cur[c]) cur_desc[c].push_back(t.descriptor);
   }
@@ -357,7 +401,7 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
 
   // Left to right: a pair shares one id.
   std::vector<std::pair<int, int>> new_pairs;  // stereo pairs with no id yet
-  if (n == 2 && !cur[0].empty() && !cur[1].empty()) {
+  if (n == 2 && !o.stereo_klt() && !cur[0].empty() && !cur[1].empty()) {
     const auto matches = match_descriptors(cur_desc[0], cur_desc[1], o.max_hamming, o.match_ratio, {});
     std::vector<Eigen::Vector2d> a, b;
     for (const auto& [i, j] : matches) {
@@ -428,6 +472,8 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
       if (it != right_partner.end()) cur[1][static_cast<std::size_t>(it->second)].point.id = id;
     }
   }
+
+  if (n == 2 && o.stereo_klt() && boxes[0] && boxes[1]) match_target_stereo_klt(*boxes[1], &cur);
 
   for (std::size_t c = 0; c < n; ++c) {
     for (const TargetPoint& t : cur[c]) store_.update(t.point.id, t.descriptor, frame_index_);

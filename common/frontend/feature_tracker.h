@@ -8,7 +8,10 @@
 // and left to right for stereo points. Target features: ORB inside the box
 // (orb_features.h), matched by descriptor frame to frame and left to right;
 // a new target track is matched against the stored target points
-// (target_point_store.h) and re-uses the id of the point it re-finds. Every
+// (target_point_store.h) and re-uses the id of the point it re-finds.
+// Optionally (target.frame_to_frame / stereo klt, anchor_align) target
+// points are followed by KLT, anchored, and matched left to right by KLT,
+// ORB only detecting new ones and closing loops. Every
 // match set (per camera frame to frame, stereo; static and target apart) is
 // cleaned by 8-point RANSAC (epipolar_ransac.h).
 //
@@ -17,6 +20,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -81,6 +85,7 @@ class FeatureTracker {
     Point point;
     Descriptor descriptor{};
   };
+  using PixelTest = std::function<bool(const cv::Point2f&)>;
 
   void check_input(int64_t utime, const cv::Mat& left, const cv::Mat& right, const std::optional<Box>& box_left,
                    const std::optional<Box>& box_right) const;
@@ -90,9 +95,11 @@ class FeatureTracker {
   /// static.anchor_align: takes `p`'s anchor patch in camera `cam`'s current
   /// image; false if it cannot be taken (edge of the image, too little texture).
   bool anchor(int cam, Point* p) const;
-  /// static.anchor_align: refines the KLT positions against the anchors,
-  /// drops the tracks whose anchor no longer matches, re-anchors deformed ones.
-  void align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const;
+  /// `p` refined against its anchor patch in camera `cam`'s current image,
+  /// re-anchored if deformed; nullopt if the anchor no longer matches.
+  std::optional<Point> aligned(int cam, const Point& p) const;
+  /// aligned() for each point; drops those that fail it or `keep`.
+  void align_to_anchors(int cam, const PixelTest& keep, std::vector<Point>* points) const;
   void detect_static(const std::optional<Box>& box);
   void match_static_stereo(const std::optional<Box>& box_right);
   void track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes);
@@ -100,10 +107,19 @@ class FeatureTracker {
   /// followed into this frame by KLT (the guess shifted by the box's
   /// motion), kept inside `box`, cleaned by RANSAC; ids and descriptors kept.
   std::vector<TargetPoint> klt_target(int cam, const Box& box);
-  /// KLT from one pyramid to another; keeps points that converge inside
-  /// `to_cam`'s image, outside `to_box`, with an undistortable pixel.
+  /// target.stereo klt: each left target point of `cur` without a right
+  /// partner looked for in the right image by KLT (kept inside `box_right`),
+  /// then one stereo RANSAC over the target pairs.
+  void match_target_stereo_klt(const Box& box_right, std::vector<std::vector<TargetPoint>>* cur);
+  /// Keep flags for `right`: false for a point whose left partner (same id)
+  /// RANSAC rejects as a stereo pair.
+  std::vector<bool> stereo_inliers(const std::vector<Point>& left, const std::vector<Point>& right);
+  /// Inside `box` and camera `cam`'s image.
+  bool in_box(int cam, const cv::Point2f& px, const Box& box) const;
+  /// KLT from one pyramid to another, the guess shifted by `shift`; keeps
+  /// points that converge where `keep` says, with an undistortable pixel.
   std::vector<Point> klt(const std::vector<cv::Mat>& from_pyr, int to_cam, const std::vector<cv::Mat>& to_pyr,
-                         const std::vector<Point>& points, const std::optional<Box>& to_box) const;
+                         const std::vector<Point>& points, cv::Point2f shift, const PixelTest& keep) const;
   double focal(int cam_a, int cam_b) const;
 
   FeatureTrackerOptions options_;

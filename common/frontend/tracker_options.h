@@ -7,7 +7,8 @@
 //            anchor_min_zncc, anchor_max_correction_px, anchor_max_scale
 //   target:  num_features, orb_fast_threshold, orb_levels, orb_scale_factor,
 //            max_hamming, match_ratio, max_motion_px, loop_closure_max_hamming,
-//            max_stored_points, frame_to_frame, min_distance_px
+//            max_stored_points, frame_to_frame, min_distance_px, stereo,
+//            anchor_align
 //   ransac:  threshold_px, confidence, max_iterations, min_points, seed
 // Every key is optional; an unknown key is an error naming it. Meanings and
 // defaults: docs/feature_tracker.md.
@@ -75,6 +76,18 @@ struct TargetTrackOptions {
   std::string frame_to_frame{"orb"};
   double min_distance_px{5.0};  // "klt": no new corner this close to a tracked target point
   bool klt() const { return frame_to_frame == "klt"; }
+  // Left to right: "descriptor" detects ORB in the right box too and matches
+  // descriptors (ORB's keypoint positions err by ~0.8 px, which the
+  // disparity takes straight into the depth); "klt" (with frame_to_frame
+  // klt) finds each left target point without a right partner in the right
+  // image by KLT, as the static points, and follows right points frame to
+  // frame like the left ones: no ORB in the right image.
+  std::string stereo{"descriptor"};
+  bool stereo_klt() const { return stereo == "klt"; }
+  // frame_to_frame klt: each KLT position refined against the track's
+  // anchor patch (the static anchor_* options), so a target track does not
+  // drift as it lives on.
+  bool anchor_align{false};
   void validate() const;
 };
 

@@ -289,7 +289,19 @@ TEST_CASE("stereo target features share one id in both cameras, at the target's 
   right.p_IinC = Eigen::Vector3d(-0.1, 0.0, 0.0);
   const cv::Mat background = test::make_texture(640, 480, 61, 1500);
   const cv::Mat patch = test::make_texture(kPatchW, kPatchH, 62, 150);
-  FeatureTracker tracker(FeatureTrackerOptions{}, {left, right});
+  // ORB in both images matched by descriptor (keypoints within ~1 px), or
+  // KLT-followed target points found in the right image by KLT, anchored
+  // (within the static stereo bound, 0.5 px).
+  FeatureTrackerOptions options;
+  double tolerance_px = 2.0;
+  SECTION("descriptor") {}
+  SECTION("klt") {
+    options.target.frame_to_frame = "klt";
+    options.target.stereo = "klt";
+    options.target.anchor_align = true;
+    tolerance_px = 0.5;
+  }
+  FeatureTracker tracker(options, {left, right});
   const cv::Point disparity(24, 0);
   std::map<int64_t, Eigen::Vector2d> first_left;
   for (int k = 0; k < 2; ++k) {
@@ -302,7 +314,7 @@ TEST_CASE("stereo target features share one id in both cameras, at the target's 
       const auto it = l.find(id);
       if (it == l.end()) continue;
       ++shared;
-      correct += (it->second - px - Eigen::Vector2d(disparity.x, disparity.y)).norm() < 2.0 ? 1 : 0;
+      correct += (it->second - px - Eigen::Vector2d(disparity.x, disparity.y)).norm() < tolerance_px ? 1 : 0;
     }
     INFO("frame " << k << ": " << shared << " stereo target points of " << l.size() << " left, " << correct
                   << " at the disparity");

@@ -40,12 +40,16 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
       Config::from_string(
           "tracker:\n  static: {num_features: 120, klt_window_px: 11, max_track_frames: 20, anchor_align: true,\n"
           "           anchor_min_zncc: 0.7, anchor_max_correction_px: 1.5, anchor_max_scale: 1.5}\n"
-          "  target: {frame_to_frame: klt, min_distance_px: 4}\n"
+          "  target: {frame_to_frame: klt, min_distance_px: 4, stereo: klt, anchor_align: true}\n"
           "  ransac: {threshold_px: 0.5}\n"),
       "tracker");
   CHECK(o.target.klt());
   CHECK(o.target.min_distance_px == 4.0);
   CHECK_FALSE(FeatureTrackerOptions().target.klt());
+  CHECK(o.target.stereo_klt());
+  CHECK(o.target.anchor_align);
+  CHECK_FALSE(FeatureTrackerOptions().target.stereo_klt());
+  CHECK_FALSE(FeatureTrackerOptions().target.anchor_align);
   CHECK(o.static_tracks.num_features == 120);
   CHECK(o.static_tracks.max_track_frames == 20);
   CHECK(o.static_tracks.anchor_align);
@@ -69,4 +73,8 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   CHECK_THAT(error_of("tracker:\n  target: {match_ratio: 1.5}\n"), Catch::Contains("match_ratio"));
   CHECK_THAT(error_of("tracker:\n  target: {frame_to_frame: lk}\n"), Catch::Contains("frame_to_frame"));
   CHECK_THAT(error_of("tracker:\n  target: {min_distance_px: -1}\n"), Catch::Contains("min_distance_px"));
+  CHECK_THAT(error_of("tracker:\n  target: {frame_to_frame: klt, stereo: lk}\n"), Catch::Contains("target.stereo"));
+  // Both follow KLT tracks: with ORB re-detection there are none.
+  CHECK_THAT(error_of("tracker:\n  target: {stereo: klt}\n"), Catch::Contains("frame_to_frame klt"));
+  CHECK_THAT(error_of("tracker:\n  target: {anchor_align: true}\n"), Catch::Contains("frame_to_frame klt"));
 }
