@@ -139,33 +139,37 @@ bool FeatureTracker::anchor(int cam, Point* p) const {
   return true;
 }
 
-void FeatureTracker::align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const {
+std::optional<FeatureTracker::Point> FeatureTracker::align_to_anchor(int cam, const Point& p) const {
   const StaticTrackOptions& o = options_.static_tracks;
-  const cv::Mat& image = pyramid_[static_cast<std::size_t>(cam)][0];
-  const auto max_correction2 = static_cast<float>(o.anchor_max_correction_px * o.anchor_max_correction_px);
+  const std::optional<AnchorPatch::Alignment> a =
+      p.anchor->align(pyramid_[static_cast<std::size_t>(cam)][0], p.pixel, p.affine, o.klt_max_iterations,
+                      static_cast<float>(o.klt_epsilon));
+  if (!a || a->zncc < o.anchor_min_zncc) return std::nullopt;
+  const cv::Point2f correction = a->pixel - p.pixel;
+  if (correction.dot(correction) > o.anchor_max_correction_px * o.anchor_max_correction_px) return std::nullopt;
+  Point q = p;
+  q.pixel = a->pixel;
+  q.affine = a->affine;
+  if (!normalize(cam, &q)) return std::nullopt;
+  const Eigen::Vector2f scale = Eigen::JacobiSVD<Eigen::Matrix2f>(q.affine).singularValues();
+  const auto limit = static_cast<float>(o.anchor_max_scale);
+  // Far from the anchor's scale the affine model no longer describes the
+  // patch (perspective, resampling): the current patch, at the aligned
+  // position, becomes the anchor. The error made so far is kept, but it
+  // grows only at these rare steps, not every frame.
+  if (scale(0) > limit || scale(1) < 1.0f / limit) {
+    Point fresh = q;
+    if (anchor(cam, &fresh)) q = fresh;
+  }
+  return q;
+}
+
+void FeatureTracker::align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const {
   std::vector<Point> kept;
   kept.reserve(points->size());
-  for (Point& p : *points) {
-    const std::optional<AnchorPatch::Alignment> a = p.anchor->align(
-        image, p.pixel, p.affine, o.klt_max_iterations, static_cast<float>(o.klt_epsilon));
-    if (!a || a->zncc < o.anchor_min_zncc) continue;
-    const cv::Point2f correction = a->pixel - p.pixel;
-    if (correction.dot(correction) > max_correction2 || !usable(cam, a->pixel, box)) continue;
-    Point q = p;
-    q.pixel = a->pixel;
-    q.affine = a->affine;
-    if (!normalize(cam, &q)) continue;
-    const Eigen::Vector2f scale = Eigen::JacobiSVD<Eigen::Matrix2f>(q.affine).singularValues();
-    const auto limit = static_cast<float>(o.anchor_max_scale);
-    // Far from the anchor's scale the affine model no longer describes the
-    // patch (perspective, resampling): the current patch, at the aligned
-    // position, becomes the anchor. The error made so far is kept, but it
-    // grows only at these rare steps, not every frame.
-    if (scale(0) > limit || scale(1) < 1.0f / limit) {
-      Point fresh = q;
-      if (anchor(cam, &fresh)) q = fresh;
-    }
-    kept.push_back(std::move(q));
+  for (const Point& p : *points) {
+    std::optional<Point> q = align_to_anchor(cam, p);
+    if (q && usable(cam, q->pixel, box)) kept.push_back(std::move(*q));
   }
   points->swap(kept);
 }
@@ -280,10 +284,16 @@ std::vector<FeatureTracker::TargetPoint> FeatureTracker::klt_target(int cam, con
   std::vector<Eigen::Vector2d> a, b;
   std::vector<TargetPoint> out;
   for (std::size_t i = 0; i < prev.size(); ++i) {
-    if (!status[i] || !box.contains(to[i].x, to[i].y)) continue;
+    if (!status[i]) continue;
     TargetPoint t = prev[i];
     t.point.pixel = to[i];
     if (!normalize(cam, &t.point)) continue;
+    if (options_.target.anchor_align) {
+      std::optional<Point> aligned = align_to_anchor(cam, t.point);
+      if (!aligned) continue;
+      t.point = std::move(*aligned);
+    }
+    if (!box.contains(t.point.pixel.x, t.point.pixel.y)) continue;
     a.push_back(prev[i].point.normalized);
     b.push_back(t.point.normalized);
     out.push_back(t);
@@ -318,7 +328,8 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
       TargetPoint t;
       t.point.pixel = f.pixel;
       t.descriptor = f.descriptor;
-      if (normalize(cam, &t.point)) cur[c].push_back(t);
+      if (!normalize(cam, &t.point) || (o.anchor_align && !anchor(cam, &t.point))) continue;
+      cur[c].push_back(t);
     }
     for (const TargetPoint& t : cur[c]) cur_desc[c].push_back(t.descriptor);
   }

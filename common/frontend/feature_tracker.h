@@ -90,6 +90,10 @@ class FeatureTracker {
   /// static.anchor_align: takes `p`'s anchor patch in camera `cam`'s current
   /// image; false if it cannot be taken (edge of the image, too little texture).
   bool anchor(int cam, Point* p) const;
+  /// `p` (its KLT position) aligned to its anchor patch in camera `cam`'s
+  /// current image, re-anchored if deformed; nullopt when the anchor no
+  /// longer matches (static.anchor_* limits). Static and target tracks.
+  std::optional<Point> align_to_anchor(int cam, const Point& p) const;
   /// static.anchor_align: refines the KLT positions against the anchors,
   /// drops the tracks whose anchor no longer matches, re-anchors deformed ones.
   void align_to_anchors(int cam, const std::optional<Box>& box, std::vector<Point>* points) const;
@@ -98,7 +102,8 @@ class FeatureTracker {
   void track_target(const std::vector<cv::Mat>& images, const std::vector<std::optional<Box>>& boxes);
   /// target.frame_to_frame klt: the previous frame's target points of `cam`
   /// followed into this frame by KLT (the guess shifted by the box's
-  /// motion), kept inside `box`, cleaned by RANSAC; ids and descriptors kept.
+  /// motion), with target.anchor_align refined against their anchors, kept
+  /// inside `box`, cleaned by RANSAC; ids and descriptors kept.
   std::vector<TargetPoint> klt_target(int cam, const Box& box);
   /// KLT from one pyramid to another; keeps points that converge inside
   /// `to_cam`'s image, outside `to_box`, with an undistortable pixel.

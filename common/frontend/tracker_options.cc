@@ -63,6 +63,7 @@ void TargetTrackOptions::validate() const {
   require(frame_to_frame == "orb" || frame_to_frame == "klt",
           "target.frame_to_frame must be orb or klt, got '" + frame_to_frame + "'");
   require(min_distance_px >= 0.0, "target.min_distance_px must be >= 0");
+  require(!anchor_align || klt(), "target.anchor_align needs target.frame_to_frame klt");
 }
 
 void RansacOptions::validate() const {
@@ -88,7 +89,8 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
              "max_track_frames", "anchor_align", "anchor_min_zncc", "anchor_max_correction_px", "anchor_max_scale"});
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
-             "max_motion_px", "loop_closure_max_hamming", "max_stored_points", "frame_to_frame", "min_distance_px"});
+             "max_motion_px", "loop_closure_max_hamming", "max_stored_points", "frame_to_frame", "min_distance_px",
+             "anchor_align"});
   only_keys(cfg, s + "ransac", {"threshold_px", "confidence", "max_iterations", "min_points", "seed"});
 
   StaticTrackOptions& st = o.static_tracks;
@@ -121,6 +123,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "target.max_stored_points", &t.max_stored_points);
   read(cfg, s + "target.frame_to_frame", &t.frame_to_frame);
   read(cfg, s + "target.min_distance_px", &t.min_distance_px);
+  read(cfg, s + "target.anchor_align", &t.anchor_align);
 
   RansacOptions& r = o.ransac;
   read(cfg, s + "ransac.threshold_px", &r.threshold_px);

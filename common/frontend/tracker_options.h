@@ -7,7 +7,7 @@
 //            anchor_min_zncc, anchor_max_correction_px, anchor_max_scale
 //   target:  num_features, orb_fast_threshold, orb_levels, orb_scale_factor,
 //            max_hamming, match_ratio, max_motion_px, loop_closure_max_hamming,
-//            max_stored_points, frame_to_frame, min_distance_px
+//            max_stored_points, frame_to_frame, min_distance_px, anchor_align
 //   ransac:  threshold_px, confidence, max_iterations, min_points, seed
 // Every key is optional; an unknown key is an error naming it. Meanings and
 // defaults: docs/feature_tracker.md.
@@ -74,6 +74,10 @@ struct TargetTrackOptions {
   // are what the monocular object tracker's initialisation needs.
   std::string frame_to_frame{"orb"};
   double min_distance_px{5.0};  // "klt": no new corner this close to a tracked target point
+  // "klt" only: each target KLT position is refined against the track's
+  // anchor patch as static.anchor_align does (the static anchor_* limits),
+  // so a long target track does not drift.
+  bool anchor_align{false};
   bool klt() const { return frame_to_frame == "klt"; }
   void validate() const;
 };

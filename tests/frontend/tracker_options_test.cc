@@ -40,11 +40,12 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
       Config::from_string(
           "tracker:\n  static: {num_features: 120, klt_window_px: 11, max_track_frames: 20, anchor_align: true,\n"
           "           anchor_min_zncc: 0.7, anchor_max_correction_px: 1.5, anchor_max_scale: 1.5}\n"
-          "  target: {frame_to_frame: klt, min_distance_px: 4}\n"
+          "  target: {frame_to_frame: klt, min_distance_px: 4, anchor_align: true}\n"
           "  ransac: {threshold_px: 0.5}\n"),
       "tracker");
   CHECK(o.target.klt());
   CHECK(o.target.min_distance_px == 4.0);
+  CHECK(o.target.anchor_align);
   CHECK_FALSE(FeatureTrackerOptions().target.klt());
   CHECK(o.static_tracks.num_features == 120);
   CHECK(o.static_tracks.max_track_frames == 20);
@@ -69,4 +70,6 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   CHECK_THAT(error_of("tracker:\n  target: {match_ratio: 1.5}\n"), Catch::Contains("match_ratio"));
   CHECK_THAT(error_of("tracker:\n  target: {frame_to_frame: lk}\n"), Catch::Contains("frame_to_frame"));
   CHECK_THAT(error_of("tracker:\n  target: {min_distance_px: -1}\n"), Catch::Contains("min_distance_px"));
+  // Anchoring refines KLT positions: with ORB re-detection it has nothing to refine.
+  CHECK_THAT(error_of("tracker:\n  target: {anchor_align: true}\n"), Catch::Contains("target.anchor_align"));
 }
