@@ -84,6 +84,10 @@ int run(int argc, const char* const* argv) {
     const std::string name = "target, age " + std::to_string(ages[a]) + "-" +
                              (ages[a + 1] == (1 << 30) ? std::string("") : std::to_string(ages[a + 1] - 1));
     row(name, e, [&](const E& x) { return x.is_target && x.age >= ages[a] && x.age < ages[a + 1]; });
+    // The same without the tracks born on the room seen past the target's
+    // silhouette: the tracker's drift apart from its labelling.
+    row(name + ", born on", e,
+        [&](const E& x) { return x.is_target && x.born_on_target && x.age >= ages[a] && x.age < ages[a + 1]; });
   }
   return 0;
 }

@@ -107,7 +107,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
                      "min_init_parallax_deg", "init_frames", "init_min_chi2_gap", "ransac_threshold_px",
                      "reference_features", "min_track_features", "max_reprojection_rms_px", "outlier_threshold_px",
                      "min_feature_parallax_deg", "min_feature_observations", "max_iterations",
-                     "keyframe_rotation_deg", "keyframe_baseline", "reassociation_px"});
+                     "keyframe_rotation_deg", "keyframe_baseline", "reassociation_px", "max_retired_poses"});
   const Config c = config.sub("object_tracker");
   o.window_size = c.get_or<int>("window_size", o.window_size);
   o.focal_length_px = c.get_or<double>("focal_length_px", o.focal_length_px);
@@ -128,6 +128,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.keyframe_rotation_deg = c.get_or<double>("keyframe_rotation_deg", o.keyframe_rotation_deg);
   o.keyframe_baseline = c.get_or<double>("keyframe_baseline", o.keyframe_baseline);
   o.reassociation_px = c.get_or<double>("reassociation_px", o.reassociation_px);
+  o.max_retired_poses = c.get_or<int>("max_retired_poses", o.max_retired_poses);
   auto require = [&c](bool ok, const std::string& key, const std::string& what) {
     if (!ok) c.fail(key, what + ", got " + c.get<std::string>(key));
   };
@@ -141,6 +142,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   require(o.reference_features >= 1, "reference_features", "must be >= 1");
   require(o.min_track_features >= 4, "min_track_features", "must be >= 4");
   require(o.min_feature_observations >= 2, "min_feature_observations", "must be >= 2");
+  require(o.max_retired_poses >= 0, "max_retired_poses", "must be >= 0 (0: no limit)");
   return o;
 }
 
@@ -620,6 +622,16 @@ void ObjectTracker::slide_window() {
     // errors for good.
     for (auto& [id, f] : features_) {
       if (!f.in_ba) f.observations.erase(oldest);
+    }
+  }
+  if (options_.max_retired_poses > 0) {
+    // poses_ is ordered by utime and every retired pose is older than the
+    // window: the first ones are the oldest retired.
+    const std::size_t retired = poses_.size() - window_.size();
+    for (std::size_t k = static_cast<std::size_t>(options_.max_retired_poses); k < retired; ++k) {
+      const int64_t oldest = poses_.begin()->first;
+      for (auto& [id, f] : features_) f.observations.erase(oldest);
+      poses_.erase(poses_.begin());
     }
   }
   // Feature ids are never reused after a track loss, so a candidate not seen

@@ -79,6 +79,11 @@ struct ObjectTrackerOptions {
   // one BA point not seen in the frame (and no other within twice it) is
   // that point again (a broken track of the front end).
   double reassociation_px{4.0};
+  // Retired poses kept (the newest); older ones are forgotten with their
+  // views. Each retired pose adds its views of the living points to every
+  // solve, so long tracks (from pixels) would grow the BA without bound.
+  // 0 = no limit.
+  int max_retired_poses{0};
 };
 
 /// Reads the `object_tracker:` section (every key optional, defaults above).
