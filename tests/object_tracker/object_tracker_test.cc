@@ -21,16 +21,24 @@
 //    is ≈ 0.7°). O's orientation is the reference frame's estimated pose,
 //    one more such single-frame error, constant over the track: √2 · 0.7° ≈
 //    1.0°, so 1.5° RMS would leave half a degree for the structure. The
-//    tracker does NOT meet that (1.4-3.4° on seeds 1-6: the structure of its
-//    2 s initialisation adds a constant offset of up to 3.1°,
-//    docs/object_tracker.md "Open issues"), so it is not tested. What is
-//    tested: (a) the frame-to-frame jitter of the error e_k (RMS of
-//    (e_k - e_k-1)/√2, which removes everything constant or slow) is the
-//    frame's own measurement noise, whose floor is the per-frame CRB, plus
-//    the change of the structure estimate from one frame to the next; that
-//    change is driven by one more frame's observations of the same points,
-//    so it moves the pose by at most as much again: jitter < √2 · CRB;
-//    (b) no gross error: rotation RMS < 5°, where a wrong initialisation
+//    tracker does NOT meet that on the whole error (1.4-3.4° on seeds 1-6),
+//    because of a constant offset of 0.9-3.1°: the error e_k = log(R_OtoC,trueᵀ
+//    R_OtoC,k) (in O) has a mean that the track carries from its 2 s
+//    initialisation (docs/object_tracker.md "Open issues"). A constant
+//    error δ on the right, R_OtoC,k = R_OtoC,true,k δ, is a rotation of O
+//    in the object, i.e. a different choice of O's axes: every relative
+//    rotation R_OtoC,k R_OtoC,jᵀ (and R_OtoG,k R_OtoG,jᵀ, Eq. 21) and
+//    the position of O's origin are unaffected by it. So the hard checks
+//    are: (a) the 1.5° on the error with its constant removed (RMS of
+//    e_k - mean e), which holds everything that moves the object's pose
+//    relative to its other tracked poses (the budget's constant C0 term is
+//    then slack; the structure's slow error uses it, docs); (b) the frame-to-frame jitter of
+//    e_k (RMS of (e_k - e_k-1)/√2, which removes everything constant or slow)
+//    is the frame's own measurement noise, whose floor is the per-frame CRB,
+//    plus the change of the structure estimate from one frame to the next;
+//    that change is driven by one more frame's observations of the same
+//    points, so it moves the pose by at most as much again: jitter < √2 · CRB;
+//    (c) no gross error: rotation RMS < 5°, where a wrong initialisation
 //    (the other Necker structure, or the 20-30° off ones seen with
 //    outliers) is 4× beyond. Position: the range follows from the
 //    image size of the box (≈ 80 px at 2.5 m) to σ/(40 px √N) ≈ 0.4 % ≈ 1 cm
@@ -72,6 +80,9 @@ struct Accuracy {
   double rotation_rms_deg{0.0};
   // Split of the rotation error e_k = log(R_OtoC,trueᵀ R_OtoC) (in O):
   double rotation_offset_deg{0.0};  // |mean e|, constant over the track
+  // RMS of the error with the best constant rotation of O removed: the error
+  // of every relative rotation R_OtoC,k R_OtoC,jᵀ, blind to O's orientation.
+  double rotation_aligned_rms_deg{0.0};
   double rotation_jitter_deg{0.0};  // RMS of (e_k - e_k-1)/√2 over consecutive valid frames
   double rotation_crb_deg{0.0};     // √(mean tr CRB_k): the per-frame Cramér-Rao bound
   double position_rms_m{0.0};
@@ -183,6 +194,11 @@ Accuracy accuracy(const std::vector<Record>& records, int64_t track_id) {
     }
   }
   a.rotation_offset_deg = (sum_e / a.valid).norm() * kRadToDeg;
+  // RMS of e_k - mean e: mean |e_k|² = |mean e|² + mean |e_k - mean e|²
+  // (the rotation errors are a few degrees, where the rotation vectors
+  // compose additively to first order).
+  a.rotation_aligned_rms_deg =
+      std::sqrt(std::max(0.0, a.rotation_rms_deg * a.rotation_rms_deg - a.rotation_offset_deg * a.rotation_offset_deg));
   a.rotation_crb_deg = std::sqrt(sum_crb / a.valid) * kRadToDeg;
   a.rotation_jitter_deg = pairs > 0 ? std::sqrt(sum_jitter / pairs) * kRadToDeg : 0.0;
   a.position_rms_m = std::sqrt(sum_pos / a.valid);
@@ -201,9 +217,10 @@ Accuracy accuracy(const std::vector<Record>& records, int64_t track_id) {
 
 void print(const char* name, const Accuracy& a) {
   std::printf(
-      "%s: %d/%d frames valid, rotation RMS %.4f deg (offset %.3f, jitter %.3f, per-frame CRB %.3f deg), "
+      "%s: %d/%d frames valid, rotation RMS %.4f deg (offset %.3f, aligned %.3f, jitter %.3f, per-frame CRB %.3f deg), "
       "position RMS %.4f m (range %.2f m), scale drift %.3f %%\n",
-      name, a.valid, a.frames, a.rotation_rms_deg, a.rotation_offset_deg, a.rotation_jitter_deg, a.rotation_crb_deg,
+      name, a.valid, a.frames, a.rotation_rms_deg, a.rotation_offset_deg, a.rotation_aligned_rms_deg,
+      a.rotation_jitter_deg, a.rotation_crb_deg,
       a.position_rms_m, a.mean_range_m, 100.0 * a.scale_drift);
 }
 
@@ -244,12 +261,12 @@ std::vector<Record> run_outliers(uint64_t seed, ObjectTracker& tracker) {
   });
 }
 
-// What the rotation is held to (see the header): the frame-to-frame jitter
-// within √2 of the per-frame Cramér-Rao bound, and no gross error. The
-// header's 1.5° RMS bound on the whole error is NOT met (1.4-3.4° on seeds
-// 1-6: the initialisation's constant offset, docs/object_tracker.md "Open
-// issues") and is not tested.
+// What the rotation is held to (see the header): the error without its
+// constant part (O's orientation against the truth's, a choice of O's axes)
+// within 1.5°, the frame-to-frame jitter within √2 of the per-frame
+// Cramér-Rao bound, and no gross error.
 void check_rotation(const Accuracy& a) {
+  CHECK(a.rotation_aligned_rms_deg < 1.5);
   CHECK(a.rotation_jitter_deg < std::sqrt(2.0) * a.rotation_crb_deg);
   CHECK(a.rotation_rms_deg < 5.0);
 }
@@ -328,9 +345,9 @@ TEST_CASE("5 % of the target observations 20 px off, seed 1: outliers removed, t
   CHECK(a.position_rms_m < 0.05);
 }
 
-// The rotation check of the 1 px and gap cases on seeds 1-6 (hidden: 12
-// runs, minutes; `object_tracker_test "[.seeds]"`, figures in
-// docs/object_tracker.md).
+// The rotation check of the 1 px and gap cases on seeds 1-6 (hidden from
+// the default run: 12 runs, minutes; ctest runs it as
+// object_tracker_seeds_test, label slow; figures in docs/object_tracker.md).
 TEST_CASE("the rotation check holds on seeds 1-6", "[.seeds]") {
   for (uint64_t seed = 1; seed <= 6; ++seed) {
     INFO("seed " << seed);
