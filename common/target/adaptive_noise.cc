@@ -53,6 +53,7 @@ void AdaptiveNoise::end_frame(const Eigen::VectorXd& x_minus, const Eigen::Vecto
     f.q_sum += dx * dx - (P_minus(j) - P_plus(j)) + q_used;
     f.unit_sum += dt;
   }
+  f.dt = dt;
   finish(f, true);
 }
 
@@ -63,13 +64,18 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
   f.dof = frame_dof_;
   frame_chi2_ = 0.0;
   frame_dof_ = 0;
+  inflation_ = 0.0;
   const double frame_nis = f.dof > 0 ? f.chi2 / f.dof : 0.0;
   if (f.dof > 0 && f.chi2 > options_.nis_max * estimator::chi2_quantile(0.99, f.dof)) {
     ++violations_;
+    double tau = f.dt;  // how long the rejected σ has been used
+    for (const Frame& w : window_) tau += w.dt;
     window_.clear();
     frames_since_violation_ = 0;
     consistent_ = false;
+    const double old_sigma = sigma_;
     sigma_ = std::min(options_.sigma_max, sigma_ * std::sqrt(std::min(frame_nis, options_.max_step)));
+    inflation_ = (sigma_ * sigma_ - old_sigma * old_sigma) * tau;
     return;
   }
   window_.push_back(f);

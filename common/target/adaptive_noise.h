@@ -17,7 +17,10 @@
 // exceeds nis_max · χ²_0.99(Σdof) violates the model: the window's evidence (gathered under a
 // rejected σ) is dropped and σ² is inflated by min(NIS, max_step) — when the
 // gate rejects the target's measurements no update carries the matching
-// signal, so the innovations must. The model is judged consistent (tight
+// signal, so the innovations must — and the driven components' variance
+// gets what the new σ would have added over the time the rejected one was
+// used, (σ_new² − σ_old²) τ (inflation(): the filter's P of the target
+// was computed with a σ now judged wrong). The model is judged consistent (tight
 // coupling allowed) once `window` frames have passed without a violation and
 // the windowed NIS is at most nis_max.
 
@@ -58,11 +61,15 @@ class AdaptiveNoise {
   bool consistent() const { return consistent_; }
   double window_nis() const;
   int64_t violations() const { return violations_; }
+  /// Variance to add to each driven component after the last frame (0
+  /// unless it violated the model).
+  double inflation() const { return inflation_; }
 
  private:
   struct Frame {
     double q_sum{0.0};     // Σ_j q̂_j
     double unit_sum{0.0};  // Σ_j dt
+    double dt{0.0};
     double chi2{0.0};
     int dof{0};
   };
@@ -76,6 +83,7 @@ class AdaptiveNoise {
   int frames_since_violation_{0};
   bool consistent_{false};
   int64_t violations_{0};
+  double inflation_{0.0};
 };
 
 }  // namespace target

@@ -182,7 +182,7 @@ std::vector<int> TargetFilter::driven_components() const {
   return {6, 7, 8, 9, 10, 11};
 }
 
-void TargetFilter::end_adaptive_frame(const State& state) {
+void TargetFilter::end_adaptive_frame(State& state) {
   if (!adaptive_ || !target_) return;
   if (!predicted_) {
     adaptive_->end_frame_innovations_only();
@@ -195,6 +195,12 @@ void TargetFilter::end_adaptive_frame(const State& state) {
       P_plus(k) = state.cov()(target_->id() + idx[k], target_->id() + idx[k]);
     }
     adaptive_->end_frame(predicted_->x, predicted_->P, x_plus, P_plus, predicted_->dt);
+  }
+  if (adaptive_->inflation() > 0.0) {
+    // Process noise the rejected σ left out (adaptive_noise.h).
+    Matrix12d Q = Matrix12d::Zero();
+    for (const int j : driven_components()) Q(j, j) = adaptive_->inflation();
+    StateHelper::propagate(state, {target_}, Matrix12d::Identity(), Q);
   }
   predicted_.reset();
   noise_ = options_.noise(adaptive_->sigma());

@@ -294,8 +294,9 @@ class TargetFilter : public estimator::VioExtension {
                     Eigen::VectorXd* r) const;
   // Driven components of the target's error state (planar: v_x, v_y, w_z).
   std::vector<int> driven_components() const;
-  // kAdaptive: closes the frame's covariance matching and sets noise_ to σ̂.
-  void end_adaptive_frame(const estimator::State& state);
+  // kAdaptive: closes the frame's covariance matching, sets noise_ to σ̂ and
+  // inflates the target's covariance after a model violation.
+  void end_adaptive_frame(estimator::State& state);
   // ekf_update (tightly_coupled()) or schmidt_update with nuisance_variables.
   bool apply_update(estimator::State& state, const std::vector<estimator::TypePtr>& order, const Eigen::MatrixXd& H,
                     const Eigen::VectorXd& r);
