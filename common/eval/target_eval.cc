@@ -214,7 +214,7 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
         j.field("frames_with_target_obs", r.frames_with_target_obs);
         j.field("frames_with_target_update", r.frames_with_target_update);
         j.field("longest_gap_frames", r.longest_gap_frames).field("target_max_error_m", r.target_max_error_m);
-        j.field("target_init_s", r.target_init_s);
+        j.field("target_init_s", r.target_init_s).field("cpu_ms_per_frame", r.cpu_ms_per_frame);
         j.end_object();
         const target::TargetUpdateStats& ts = r.target_stats;
         j.key("target_updates").begin_object();
