@@ -117,11 +117,9 @@ TargetSection target_section_from_config(const Config& config) {
     ad.sigma_max = positive(a, "sigma_max", ad.sigma_max);
     ad.nis_max = positive(a, "nis_max", ad.nis_max);
     ad.max_step = positive(a, "max_step", ad.max_step);
-    try {
-      ad.validate();
-    } catch (const std::invalid_argument& e) {
-      a.fail("sigma_min", e.what());
-    }
+    if (!(ad.sigma_max >= ad.sigma_min)) a.fail("sigma_max", "must be >= sigma_min");
+    if (!(ad.nis_max > 1.0)) a.fail("nis_max", "must be > 1, got " + std::to_string(ad.nis_max));
+    if (!(ad.max_step > 1.0)) a.fail("max_step", "must be > 1, got " + std::to_string(ad.max_step));
   }
   t.prediction_horizon_s = non_negative(c, "prediction_horizon_s", t.prediction_horizon_s);
   return t;
