@@ -182,19 +182,27 @@ std::vector<int> TargetFilter::driven_components() const {
   return {6, 7, 8, 9, 10, 11};
 }
 
+TargetFilter::Predicted TargetFilter::driven_now(const State& state, double dt) const {
+  const std::vector<int> idx = driven_components();
+  const Eigen::VectorXd x = target_->value();  // error index i ↔ value index i + 1 for i >= 3
+  Predicted out;
+  out.x.resize(static_cast<Eigen::Index>(idx.size()));
+  out.P.resize(static_cast<Eigen::Index>(idx.size()));
+  for (size_t k = 0; k < idx.size(); ++k) {
+    out.x(static_cast<Eigen::Index>(k)) = x(idx[k] + 1);
+    out.P(static_cast<Eigen::Index>(k)) = state.cov()(target_->id() + idx[k], target_->id() + idx[k]);
+  }
+  out.dt = dt;
+  return out;
+}
+
 void TargetFilter::end_adaptive_frame(State& state) {
   if (!adaptive_ || !target_) return;
   if (!predicted_) {
     adaptive_->end_frame_innovations_only();
   } else {
-    const std::vector<int> idx = driven_components();
-    const Eigen::VectorXd x = target_->value();  // error index i ↔ value index i + 1 for i >= 3
-    Eigen::VectorXd x_plus(idx.size()), P_plus(idx.size());
-    for (size_t k = 0; k < idx.size(); ++k) {
-      x_plus(k) = x(idx[k] + 1);
-      P_plus(k) = state.cov()(target_->id() + idx[k], target_->id() + idx[k]);
-    }
-    adaptive_->end_frame(predicted_->x, predicted_->P, x_plus, P_plus, predicted_->dt);
+    const Predicted now = driven_now(state, 0.0);
+    adaptive_->end_frame(predicted_->x, predicted_->P, now.x, now.P, predicted_->dt);
   }
   if (adaptive_->inflation() > 0.0) {
     // Process noise the rejected σ left out (adaptive_noise.h).
@@ -282,18 +290,7 @@ void TargetFilter::commit_propagation(State& state) {
   target_->set_value(v);
   target_->set_fej(v);
   pending_.reset();
-  if (adaptive_) {
-    const std::vector<int> idx = driven_components();
-    Predicted pr;
-    pr.x.resize(idx.size());
-    pr.P.resize(idx.size());
-    for (size_t k = 0; k < idx.size(); ++k) {
-      pr.x(k) = v(idx[k] + 1);
-      pr.P(k) = state.cov()(target_->id() + idx[k], target_->id() + idx[k]);
-    }
-    pr.dt = pending_dt_;
-    predicted_ = std::move(pr);
-  }
+  if (adaptive_) predicted_ = driven_now(state, pending_dt_);
 }
 
 void TargetFilter::on_clone_added(State& state, int64_t utime) {

@@ -322,6 +322,8 @@ class TargetFilter : public estimator::VioExtension {
     double dt{0.0};
   };
   std::optional<Predicted> predicted_;
+  // The driven components' values and variances now, with dt attached.
+  Predicted driven_now(const estimator::State& state, double dt) const;
   double pending_dt_{0.0};
 };
 
