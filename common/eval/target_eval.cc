@@ -98,7 +98,8 @@ std::string target_tables(const std::vector<TargetCell>& cells) {
   const struct {
     TargetUpdateMode mode;
     const char* title;
-  } tables[] = {{TargetUpdateMode::kEkf, "Table I (EKF, tightly coupled)"}, {TargetUpdateMode::kSkf, "Table II (SKF)"}};
+  } tables[] = {{TargetUpdateMode::kEkf, "Table I (EKF, tightly coupled)"}, {TargetUpdateMode::kSkf, "Table II (SKF)"},
+                {TargetUpdateMode::kAdaptive, "Adaptive (σ_t = the start of the estimate)"}};
   for (const auto& t : tables) {
     bool any = false;
     for (double s : sigmas)
@@ -213,7 +214,7 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
         j.field("frames_with_target_obs", r.frames_with_target_obs);
         j.field("frames_with_target_update", r.frames_with_target_update);
         j.field("longest_gap_frames", r.longest_gap_frames).field("target_max_error_m", r.target_max_error_m);
-        j.field("target_init_s", r.target_init_s);
+        j.field("target_init_s", r.target_init_s).field("cpu_ms_per_frame", r.cpu_ms_per_frame);
         j.end_object();
         const target::TargetUpdateStats& ts = r.target_stats;
         j.key("target_updates").begin_object();
@@ -222,6 +223,12 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
         j.field("rejected_triangulation", ts.rejected_triangulation).field("rejected_chi2", ts.rejected_chi2);
         j.field("points_initialized", ts.points_initialized).field("points_rejected_init", ts.points_rejected_init);
         j.field("point_updates", ts.point_updates).field("points_rejected_chi2", ts.points_rejected_chi2);
+        if (ts.adaptive_frames > 0) {
+          j.field("adaptive_frames", ts.adaptive_frames).field("adaptive_coupled_frames", ts.adaptive_coupled_frames);
+          j.field("adaptive_violations", ts.adaptive_violations);
+          j.field("adaptive_sigma_mean", ts.adaptive_sigma_sum / static_cast<double>(ts.adaptive_frames));
+          j.field("adaptive_sigma_last", ts.adaptive_sigma_last);
+        }
         j.end_object();
       }
       j.key("target_in_imu");

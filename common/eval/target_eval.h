@@ -86,6 +86,10 @@ struct TargetRunResult {
   bool diverged{false};
   std::string divergence_reason;
   double wall_s{0.0};
+  /// Mean thread CPU time of the estimator's frame (VIO and target filter
+  /// together, FrameTiming::total_cpu_ms) over the evaluated frames; load
+  /// dependent.
+  double cpu_ms_per_frame{0.0};
   /// Per-frame errors with 3σ bounds (only when asked for: keep_samples).
   std::vector<ErrorSample> target_in_imu_samples;
   std::vector<ErrorSample> target_in_world_samples;

@@ -114,6 +114,7 @@ const char* to_string(TargetUpdateMode mode) {
     case TargetUpdateMode::kOff: return "off";
     case TargetUpdateMode::kEkf: return "ekf";
     case TargetUpdateMode::kSkf: return "skf";
+    case TargetUpdateMode::kAdaptive: return "adaptive";
   }
   return "unknown";
 }
@@ -126,8 +127,8 @@ const char* to_string(TargetInitMode mode) {
   return "unknown";
 }
 
-TargetNoise TargetFilterOptions::noise() const {
-  return planar ? TargetNoise::planar(sigma_t, sigma_t) : TargetNoise::isotropic(sigma_t, sigma_t);
+TargetNoise TargetFilterOptions::noise(double sigma) const {
+  return planar ? TargetNoise::planar(sigma, sigma) : TargetNoise::isotropic(sigma, sigma);
 }
 
 // ---------------------------------------------------------------- filter
@@ -145,6 +146,10 @@ TargetFilter::TargetFilter(estimator::VioEstimator& estimator, const TargetFilte
     throw std::invalid_argument("TargetFilterOptions: feature_init needs frames >= 2, min_points >= 1 and "
                                 "max_point_distance, sigma_w > 0");
   }
+  if (options_.mode == TargetUpdateMode::kAdaptive) {
+    adaptive_.emplace(options_.adaptive, options_.sigma_t);  // validates the options
+    noise_ = options_.noise(adaptive_->sigma());
+  }
   estimator_.set_extension(this);
 }
 
@@ -161,6 +166,57 @@ void TargetFilter::reset() {
   feature_init_info_.reset();
   init_window_.clear();
   frame_ = 0;
+  predicted_.reset();
+  if (adaptive_) {
+    adaptive_.emplace(options_.adaptive, options_.sigma_t);
+    noise_ = options_.noise(adaptive_->sigma());
+  }
+}
+
+bool TargetFilter::tightly_coupled() const {
+  return options_.mode == TargetUpdateMode::kEkf || (adaptive_ && adaptive_->consistent());
+}
+
+std::vector<int> TargetFilter::driven_components() const {
+  if (options_.planar) return {6, 7, 11};
+  return {6, 7, 8, 9, 10, 11};
+}
+
+TargetFilter::Predicted TargetFilter::driven_now(const State& state, double dt) const {
+  const std::vector<int> idx = driven_components();
+  const Eigen::VectorXd x = target_->value();  // error index i ↔ value index i + 1 for i >= 3
+  Predicted out;
+  out.x.resize(static_cast<Eigen::Index>(idx.size()));
+  out.P.resize(static_cast<Eigen::Index>(idx.size()));
+  for (size_t k = 0; k < idx.size(); ++k) {
+    out.x(static_cast<Eigen::Index>(k)) = x(idx[k] + 1);
+    out.P(static_cast<Eigen::Index>(k)) = state.cov()(target_->id() + idx[k], target_->id() + idx[k]);
+  }
+  out.dt = dt;
+  return out;
+}
+
+void TargetFilter::end_adaptive_frame(State& state) {
+  if (!adaptive_ || !target_) return;
+  if (!predicted_) {
+    adaptive_->end_frame_innovations_only();
+  } else {
+    const Predicted now = driven_now(state, 0.0);
+    adaptive_->end_frame(predicted_->x, predicted_->P, now.x, now.P, predicted_->dt);
+  }
+  if (adaptive_->inflation() > 0.0) {
+    // Process noise the rejected σ left out (adaptive_noise.h).
+    Matrix12d Q = Matrix12d::Zero();
+    for (const int j : driven_components()) Q(j, j) = adaptive_->inflation();
+    StateHelper::propagate(state, {target_}, Matrix12d::Identity(), Q);
+  }
+  predicted_.reset();
+  noise_ = options_.noise(adaptive_->sigma());
+  ++stats_.adaptive_frames;
+  if (adaptive_->consistent()) ++stats_.adaptive_coupled_frames;
+  stats_.adaptive_violations = adaptive_->violations();
+  stats_.adaptive_sigma_sum += adaptive_->sigma();
+  stats_.adaptive_sigma_last = adaptive_->sigma();
 }
 
 TargetValue TargetFilter::value() const { return target_ ? target_->get() : TargetValue(); }
@@ -198,6 +254,7 @@ bool TargetFilter::propagate_jointly(const State& state, const estimator::ImuVal
                                      Eigen::MatrixXd* Q) {
   if (!target_) return false;
   const double dt = utime_to_seconds(t1 - t0);
+  pending_dt_ = dt;
   TargetStep step = propagate_target(options_.representation, target_->get(), x0, x1, Phi_II, Q_II, dt, noise_);
   if (state.options().use_fej) {
     // Φ and Q at the first estimates of the target and IMU at t_k (x1 is its own
@@ -227,12 +284,13 @@ bool TargetFilter::propagate_jointly(const State& state, const estimator::ImuVal
   return true;
 }
 
-void TargetFilter::commit_propagation(State&) {
+void TargetFilter::commit_propagation(State& state) {
   if (!target_ || !pending_) return;
   const Eigen::VectorXd v = pending_->to_vector();
   target_->set_value(v);
   target_->set_fej(v);
   pending_.reset();
+  if (adaptive_) predicted_ = driven_now(state, pending_dt_);
 }
 
 void TargetFilter::on_clone_added(State& state, int64_t utime) {
@@ -488,6 +546,7 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
   }
   for (const auto& f : use) tracks_.remove(f->feature_id);
   update_tracks(state, std::move(use));
+  end_adaptive_frame(state);
 }
 
 estimator::ClonePoses TargetFilter::poses_in_target(const State& state, std::set<int64_t>* times) const {
@@ -527,7 +586,7 @@ std::vector<TypePtr> TargetFilter::nuisance_variables(const State& state) const 
 bool TargetFilter::apply_update(State& state, const std::vector<TypePtr>& order, const Eigen::MatrixXd& H,
                                 const Eigen::VectorXd& r) {
   const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(r.size(), r.size());
-  if (options_.mode == TargetUpdateMode::kEkf) return StateHelper::ekf_update(state, order, H, r, R);
+  if (tightly_coupled()) return StateHelper::ekf_update(state, order, H, r, R);
   return StateHelper::schmidt_update(state, order, H, r, R, nuisance_variables(state));
 }
 
@@ -586,6 +645,7 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
     Eigen::MatrixXd S = H * StateHelper::marginal_covariance(state, order) * H.transpose();
     S.diagonal().array() += 1.0;
     const double chi2 = r.dot(S.llt().solve(r));
+    if (adaptive_) adaptive_->add_innovation(chi2, static_cast<int>(r.size()));
     if (!(chi2 < options_.chi2_multiplier * estimator::chi2_95(static_cast<int>(r.size())))) {
       ++stats_.points_rejected_chi2;
       continue;
@@ -710,7 +770,7 @@ void TargetFilter::initialize_points(State& state, int64_t utime) {
     var->set_value(p_FinT);
     var->set_fej(p_FinT);
     bool initialized = false;
-    if (options_.mode == TargetUpdateMode::kEkf) {
+    if (tightly_coupled()) {
       initialized = StateHelper::initialize(state, var, layout.order(), H_R, H_L, r, 1.0, options_.chi2_multiplier);
     } else {
       // StateHelper::initialize with a Schmidt update of the remaining rows
@@ -786,6 +846,7 @@ void TargetFilter::update_tracks(State& state, std::vector<std::shared_ptr<estim
     Eigen::MatrixXd S = H_x * P_xx * H_x.transpose();
     S.diagonal().array() += 1.0;
     const double chi2 = r.dot(S.llt().solve(r));
+    if (adaptive_) adaptive_->add_innovation(chi2, static_cast<int>(r.size()));
     if (!(chi2 < options_.chi2_multiplier * estimator::chi2_95(static_cast<int>(r.size())))) {
       ++stats_.rejected_chi2;
       continue;

@@ -29,6 +29,10 @@
 //   kSkf   StateHelper::schmidt_update with every non-target variable (IMU,
 //          IMU clones, SLAM landmarks) as nuisance: robot estimate and P_RR
 //          are never changed by a target update.
+//   kAdaptive  σ_t estimated online from sigma_t on (AdaptiveNoise,
+//          adaptive_noise.h: covariance matching on v, w, windowed NIS of
+//          the target's measurement blocks); kEkf updates while the target
+//          model is judged consistent, kSkf otherwise.
 // Target points in the state (paper Eq. 2), SLAM-like: a target track
 // still seen at the current frame with observations at >= point_init_clone_times
 // target clones (longest first, up to max_target_points) is triangulated in
@@ -77,6 +81,7 @@
 #include "common/estimator/triangulation.h"
 #include "common/estimator/vio_estimator.h"
 #include "common/estimator/vio_extension.h"
+#include "common/target/adaptive_noise.h"
 #include "common/target/target_model.h"
 #include "common/target/target_types.h"
 #include "common/types/ground_truth.h"
@@ -108,7 +113,7 @@ class TargetState : public estimator::Type {
   std::shared_ptr<estimator::Vec> w_;
 };
 
-enum class TargetUpdateMode { kOff, kEkf, kSkf };
+enum class TargetUpdateMode { kOff, kEkf, kSkf, kAdaptive };
 const char* to_string(TargetUpdateMode mode);
 
 struct TargetInitSigmas {
@@ -144,7 +149,8 @@ struct TargetFilterOptions {
   TargetInitMode init_mode{TargetInitMode::kFeatures};
   TargetFeatureInit feature_init;
   TargetRepresentation representation{TargetRepresentation::kLocal};
-  double sigma_t{0.05};   // target noise density (v: m/s²/√Hz, w: rad/s²/√Hz)
+  double sigma_t{0.05};   // target noise density (v: m/s²/√Hz, w: rad/s²/√Hz); kAdaptive: its start
+  AdaptiveNoiseOptions adaptive;  // kAdaptive only
   bool planar{true};      // only v_x, v_y, w_z driven (paper Sec. IV)
   /// kGroundTruth: the start's prior. kFeatures: theta and p fix the gauge
   /// of the target frame (see above); v and w come from feature_init.
@@ -165,7 +171,9 @@ struct TargetFilterOptions {
   int point_max_lost_frames{10};
   estimator::TriangulationOptions triangulation;
 
-  TargetNoise noise() const;
+  TargetNoise noise() const { return noise(sigma_t); }
+  /// The noise model (planar or isotropic) at density sigma.
+  TargetNoise noise(double sigma) const;
 };
 
 struct TargetUpdateStats {
@@ -184,6 +192,13 @@ struct TargetUpdateStats {
   int64_t point_updates{0};          // point observations sets used in updates
   int64_t points_rejected_chi2{0};
   int64_t points_marginalized{0};
+  // kAdaptive: frames ended, of them tightly coupled (EKF), model
+  // violations, Σσ̂ over the frames (mean σ̂ = sum / frames), last σ̂.
+  int64_t adaptive_frames{0};
+  int64_t adaptive_coupled_frames{0};
+  int64_t adaptive_violations{0};
+  double adaptive_sigma_sum{0.0};
+  double adaptive_sigma_last{0.0};
   double residual_sum{0.0};
   double residual_sq_sum{0.0};
   int64_t residual_count{0};
@@ -225,6 +240,10 @@ class TargetFilter : public estimator::VioExtension {
   const TargetUpdateStats& stats() const { return stats_; }
   /// Target points in the state, by feature id.
   const std::map<int64_t, TargetPoint>& points() const { return points_; }
+  /// The σ_t estimate and consistency check (kAdaptive only, else nullptr).
+  const AdaptiveNoise* adaptive() const { return adaptive_ ? &*adaptive_ : nullptr; }
+  /// Whether target updates now change the robot (kEkf, or kAdaptive judged consistent).
+  bool tightly_coupled() const;
 
   // estimator::VioExtension
   bool propagate_jointly(const estimator::State& state, const estimator::ImuValue& x0, const estimator::ImuValue& x1,
@@ -273,7 +292,12 @@ class TargetFilter : public estimator::VioExtension {
   bool track_system(const estimator::State& state, const estimator::Feature& f, const Eigen::Vector3d& p_FinT,
                     estimator::ColumnLayout& layout, Eigen::MatrixXd* H_x, Eigen::MatrixXd* H_f,
                     Eigen::VectorXd* r) const;
-  // ekf_update (kEkf) or schmidt_update with nuisance_variables (kSkf).
+  // Driven components of the target's error state (planar: v_x, v_y, w_z).
+  std::vector<int> driven_components() const;
+  // kAdaptive: closes the frame's covariance matching, sets noise_ to σ̂ and
+  // inflates the target's covariance after a model violation.
+  void end_adaptive_frame(estimator::State& state);
+  // ekf_update (tightly_coupled()) or schmidt_update with nuisance_variables.
   bool apply_update(estimator::State& state, const std::vector<estimator::TypePtr>& order, const Eigen::MatrixXd& H,
                     const Eigen::VectorXd& r);
 
@@ -290,6 +314,17 @@ class TargetFilter : public estimator::VioExtension {
   TargetUpdateStats stats_;
   std::map<int64_t, TargetPoint> points_;
   int64_t frame_{0};
+  std::optional<AdaptiveNoise> adaptive_;
+  // kAdaptive: driven components' values and covariance after this frame's
+  // propagation, and its length (s).
+  struct Predicted {
+    Eigen::VectorXd x, P;
+    double dt{0.0};
+  };
+  std::optional<Predicted> predicted_;
+  // The driven components' values and variances now, with dt attached.
+  Predicted driven_now(const estimator::State& state, double dt) const;
+  double pending_dt_{0.0};
 };
 
 }  // namespace target

@@ -31,7 +31,8 @@ TargetUpdateMode parse_target_mode(const std::string& s) {
   if (s == "skf") return TargetUpdateMode::kSkf;
   if (s == "ekf") return TargetUpdateMode::kEkf;
   if (s == "off") return TargetUpdateMode::kOff;
-  throw std::invalid_argument("target mode must be skf, ekf or off, got '" + s + "'");
+  if (s == "adaptive") return TargetUpdateMode::kAdaptive;
+  throw std::invalid_argument("target mode must be skf, ekf, adaptive or off, got '" + s + "'");
 }
 
 TargetRepresentation parse_target_representation(const std::string& s) {
@@ -51,7 +52,8 @@ TargetSection target_section_from_config(const Config& config) {
   if (!config.has("target")) return t;
   const Config c = config.sub("target");
   config.check_keys("target", {"mode", "representation", "sigma_t", "planar", "chi2_multiplier", "min_clone_times",
-                               "observability_constraint", "init", "init_sigmas", "points", "prediction_horizon_s"});
+                               "observability_constraint", "init", "init_sigmas", "points", "adaptive",
+                               "prediction_horizon_s"});
   TargetFilterOptions& o = t.filter;
   if (c.has("mode")) {
     const std::string mode = c.get<std::string>("mode");
@@ -105,6 +107,19 @@ TargetSection target_section_from_config(const Config& config) {
     o.max_target_points = at_least(p, "max", o.max_target_points, 0);
     o.point_init_clone_times = at_least(p, "init_clone_times", o.point_init_clone_times, 2);
     o.point_max_lost_frames = at_least(p, "max_lost_frames", o.point_max_lost_frames, 1);
+  }
+  if (c.has("adaptive")) {
+    c.check_keys("adaptive", {"window", "sigma_min", "sigma_max", "nis_max", "max_step"});
+    const Config a = c.sub("adaptive");
+    AdaptiveNoiseOptions& ad = o.adaptive;
+    ad.window = at_least(a, "window", ad.window, 2);
+    ad.sigma_min = positive(a, "sigma_min", ad.sigma_min);
+    ad.sigma_max = positive(a, "sigma_max", ad.sigma_max);
+    ad.nis_max = positive(a, "nis_max", ad.nis_max);
+    ad.max_step = positive(a, "max_step", ad.max_step);
+    if (!(ad.sigma_max >= ad.sigma_min)) a.fail("sigma_max", "must be >= sigma_min");
+    if (!(ad.nis_max > 1.0)) a.fail("nis_max", "must be > 1, got " + std::to_string(ad.nis_max));
+    if (!(ad.max_step > 1.0)) a.fail("max_step", "must be > 1, got " + std::to_string(ad.max_step));
   }
   t.prediction_horizon_s = non_negative(c, "prediction_horizon_s", t.prediction_horizon_s);
   return t;

@@ -3,7 +3,7 @@
 // by the target_filter process and by vimot-target-eval. No LCM here.
 //
 //   target:
-//     mode: skf | ekf | off | none   (none: no filter attached, the process
+//     mode: skf | ekf | adaptive | off | none   (none: no filter attached, the process
 //                                     runs pure VIO; the evaluator refuses it)
 //     representation: local | global
 //     sigma_t, planar, chi2_multiplier, min_clone_times, observability_constraint,
@@ -11,6 +11,7 @@
 //            max_point_distance, sigma_w}   (docs/target_model.md),
 //     init_sigmas: {theta, p, v, w},
 //     points: {max, init_clone_times, max_lost_frames},
+//     adaptive: {window, sigma_min, sigma_max, nis_max, max_step}   (mode adaptive),
 //     prediction_horizon_s   (the process's TARGET_PREDICTION horizon)
 // Every key optional (TargetFilterOptions' defaults); an unknown key or a
 // bad value is a ConfigError naming the file and the full key.

@@ -93,7 +93,8 @@ int run(int argc, const char* const* argv) {
   args.add_option("vins-config", "FILE", "estimator config", "config/vins.yaml");
   args.add_option("target-config", "FILE", "target filter config (`target:` section)", "config/target_filter.yaml");
   args.add_option("sigmas", "LIST", "comma-separated σ_t values", "0.001,0.005,0.01,0.05,0.1,0.5");
-  args.add_option("modes", "LIST", "comma-separated: ekf,skf", "ekf,skf");
+  args.add_option("modes", "LIST", "comma-separated: ekf,skf,adaptive (adaptive: σ_t estimated from the cell's on)",
+                  "ekf,skf");
   args.add_option("representations", "LIST", "comma-separated: global,local", "global,local");
   args.add_flag("no-vio-only", "skip the VIO-only row");
   args.add_option("target-init", "MODE",
@@ -150,7 +151,9 @@ int run(int argc, const char* const* argv) {
   }
   o.modes.clear();
   for (const std::string& s : split(args.get("modes"))) {
-    if (s != "ekf" && s != "skf") throw ArgError("--modes: expected ekf and/or skf, got '" + s + "'");
+    if (s != "ekf" && s != "skf" && s != "adaptive") {
+      throw ArgError("--modes: expected ekf, skf and/or adaptive, got '" + s + "'");
+    }
     o.modes.push_back(target::parse_target_mode(s));
   }
   o.representations.clear();

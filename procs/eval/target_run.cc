@@ -64,6 +64,8 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     if (e.kind == NodeEvent::Kind::kError && !pipeline->stopped()) stop(e.message);
   };
   // After each processed frame (the filter's update is done by then).
+  double cpu_ms_sum = 0.0;
+  int64_t cpu_frames = 0;
   callbacks.on_nav_state = [&](const NavState& nav) {
     if (!nav.updated || pipeline->stopped()) return;
     const int64_t utime = nav.utime;
@@ -83,6 +85,8 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
     r.frames_with_target_obs += has_target_obs ? 1 : 0;
     if (filter) r.frames_with_target_update += updated_target ? 1 : 0;
     const estimator::VioEstimator& est = node_ptr->estimator();
+    cpu_ms_sum += est.last_timing().total_cpu_ms;
+    ++cpu_frames;
     try {
       e_imu.add(error_of(nav, truth));
       if (filter && filter->initialized() && truth.has_target) {
@@ -152,6 +156,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   r.target_in_world = e_tg.summary();
   r.imu = e_imu.summary();
   r.frames_processed = node.frames_processed();
+  r.cpu_ms_per_frame = cpu_frames > 0 ? cpu_ms_sum / static_cast<double>(cpu_frames) : 0.0;
   if (node.filter()) r.target_stats = node.filter()->stats();
   if (node.filter() && !r.diverged && filter_options->mode != TargetUpdateMode::kOff && !r.target_initialized) {
     r.diverged = true;

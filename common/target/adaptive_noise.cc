@@ -1,0 +1,99 @@
+#include "common/target/adaptive_noise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "common/estimator/chi_square.h"
+
+namespace vimot {
+namespace target {
+
+void AdaptiveNoiseOptions::validate() const {
+  if (window < 2) throw std::invalid_argument("adaptive: window must be >= 2, got " + std::to_string(window));
+  if (!(sigma_min > 0.0) || !(sigma_max >= sigma_min) || !std::isfinite(sigma_max)) {
+    throw std::invalid_argument("adaptive: need 0 < sigma_min <= sigma_max < inf");
+  }
+  if (!(nis_max > 1.0)) throw std::invalid_argument("adaptive: nis_max must be > 1");
+  if (!(max_step > 1.0) || !std::isfinite(max_step)) throw std::invalid_argument("adaptive: max_step must be > 1");
+}
+
+AdaptiveNoise::AdaptiveNoise(const AdaptiveNoiseOptions& options, double sigma0) : options_(options) {
+  options_.validate();
+  sigma_ = std::clamp(sigma0, options_.sigma_min, options_.sigma_max);
+}
+
+void AdaptiveNoise::add_innovation(double chi2, int dof) {
+  if (dof <= 0 || !std::isfinite(chi2)) return;
+  frame_chi2_ += chi2;
+  frame_dof_ += dof;
+}
+
+double AdaptiveNoise::window_nis() const {
+  double chi2 = 0.0;
+  int dof = 0;
+  for (const Frame& f : window_) {
+    chi2 += f.chi2;
+    dof += f.dof;
+  }
+  return dof > 0 ? chi2 / dof : 0.0;
+}
+
+void AdaptiveNoise::end_frame(const Eigen::VectorXd& x_minus, const Eigen::VectorXd& P_minus,
+                              const Eigen::VectorXd& x_plus, const Eigen::VectorXd& P_plus, double dt) {
+  const Eigen::Index n = x_minus.size();
+  if (x_plus.size() != n || P_minus.size() != n || P_plus.size() != n || !(dt > 0.0)) {
+    throw std::invalid_argument("AdaptiveNoise::end_frame: sizes differ or dt <= 0");
+  }
+  Frame f;
+  const double q_used = sigma_ * sigma_ * dt;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double dx = x_plus(j) - x_minus(j);
+    f.q_sum += dx * dx - (P_minus(j) - P_plus(j)) + q_used;
+    f.unit_sum += dt;
+  }
+  f.dt = dt;
+  finish(f, true);
+}
+
+void AdaptiveNoise::end_frame_innovations_only() { finish(Frame{}, false); }
+
+void AdaptiveNoise::finish(Frame f, bool has_matching) {
+  f.chi2 = frame_chi2_;
+  f.dof = frame_dof_;
+  frame_chi2_ = 0.0;
+  frame_dof_ = 0;
+  inflation_ = 0.0;
+  const double frame_nis = f.dof > 0 ? f.chi2 / f.dof : 0.0;
+  if (f.dof > 0 && f.chi2 > options_.nis_max * estimator::chi2_quantile(0.99, f.dof)) {
+    ++violations_;
+    double tau = f.dt;  // how long the rejected σ has been used
+    for (const Frame& w : window_) tau += w.dt;
+    window_.clear();
+    frames_since_violation_ = 0;
+    consistent_ = false;
+    const double old_sigma = sigma_;
+    sigma_ = std::min(options_.sigma_max, sigma_ * std::sqrt(std::min(frame_nis, options_.max_step)));
+    inflation_ = (sigma_ * sigma_ - old_sigma * old_sigma) * tau;
+    return;
+  }
+  window_.push_back(f);
+  while (static_cast<int>(window_.size()) > options_.window) window_.pop_front();
+  ++frames_since_violation_;
+  if (has_matching) {
+    double q = 0.0, unit = 0.0;
+    for (const Frame& w : window_) {
+      q += w.q_sum;
+      unit += w.unit_sum;
+    }
+    // Half a window of evidence before σ̂ replaces the current value.
+    if (unit > 0.0 && 2 * static_cast<int>(window_.size()) >= options_.window) {
+      sigma_ = std::clamp(std::sqrt(std::max(q / unit, 0.0)), options_.sigma_min, options_.sigma_max);
+    }
+  }
+  consistent_ = frames_since_violation_ >= options_.window && window_nis() <= options_.nis_max;
+}
+
+}  // namespace target
+}  // namespace vimot

@@ -1,0 +1,90 @@
+#pragma once
+// Online estimate of the target's process-noise density σ_t and a check of
+// the target model's consistency (the `adaptive` target mode; derivation in
+// docs/target_model.md, "Adaptive target noise").
+//
+// Covariance matching (Myers & Tapley) on the driven components j of the
+// target's velocities (planar: v_x, v_y, w_z). Their transition is the
+// identity and their discrete noise σ² dt (target_model.h), so for one frame
+//   P⁻ = P⁺_prev + σ² dt,   E[Δx Δxᵀ] = P⁻ − P⁺   (Δx = x⁺ − x⁻, all updates)
+// if σ is right, and each frame gives the unbiased sample
+//   q̂_j = Δx_j² − (P⁻_jj − P⁺_jj) + σ_used² dt.
+// Over a window of W frames, σ̂² = Σ q̂ / Σ dt (per component), clamped.
+//
+// Consistency: the normalised innovation squared of the target's measurement
+// blocks (χ² before the gate, so rejected blocks count) per frame and over
+// the window, NIS = Σχ² / Σdof (1 for a right model). A frame whose Σχ²
+// exceeds nis_max · χ²_0.99(Σdof) violates the model: the window's evidence (gathered under a
+// rejected σ) is dropped and σ² is inflated by min(NIS, max_step) — when the
+// gate rejects the target's measurements no update carries the matching
+// signal, so the innovations must — and the driven components' variance
+// gets what the new σ would have added over the time the rejected one was
+// used, (σ_new² − σ_old²) τ (inflation(): the filter's P of the target
+// was computed with a σ now judged wrong). The model is judged consistent (tight
+// coupling allowed) once `window` frames have passed without a violation and
+// the windowed NIS is at most nis_max.
+
+#include <Eigen/Core>
+#include <deque>
+
+namespace vimot {
+namespace target {
+
+struct AdaptiveNoiseOptions {
+  int window{40};           // frames of the matching and NIS windows
+  double sigma_min{0.001};  // clamp of σ̂ (m/s²/√Hz, rad/s²/√Hz)
+  double sigma_max{2.0};
+  /// Bound of the windowed NIS, and factor on a frame's χ²_0.99(Σdof): the
+  /// blocks of a frame share the target's pose error, so Σχ² is wider than
+  /// χ²(Σdof) and the plain quantile would flag consistent frames.
+  double nis_max{2.0};
+  double max_step{4.0};     // largest σ² factor of one violating frame
+  /// Throws std::invalid_argument naming the bad option.
+  void validate() const;
+};
+
+class AdaptiveNoise {
+ public:
+  AdaptiveNoise(const AdaptiveNoiseOptions& options, double sigma0);
+
+  /// χ² and dof of one target measurement block of the current frame.
+  void add_innovation(double chi2, int dof);
+  /// Ends a frame whose propagation used sigma() over dt seconds: x⁻, P⁻ of
+  /// the driven components after that propagation, x⁺, P⁺ after every
+  /// update of the frame (diagonals). Updates sigma() and consistent().
+  void end_frame(const Eigen::VectorXd& x_minus, const Eigen::VectorXd& P_minus, const Eigen::VectorXd& x_plus,
+                 const Eigen::VectorXd& P_plus, double dt);
+  /// Ends a frame with no propagation to match (the target's first frame).
+  void end_frame_innovations_only();
+
+  double sigma() const { return sigma_; }
+  bool consistent() const { return consistent_; }
+  double window_nis() const;
+  int64_t violations() const { return violations_; }
+  /// Variance to add to each driven component after the last frame (0
+  /// unless it violated the model).
+  double inflation() const { return inflation_; }
+
+ private:
+  struct Frame {
+    double q_sum{0.0};     // Σ_j q̂_j
+    double unit_sum{0.0};  // Σ_j dt
+    double dt{0.0};
+    double chi2{0.0};
+    int dof{0};
+  };
+  void finish(Frame f, bool has_matching);
+
+  AdaptiveNoiseOptions options_;
+  double sigma_;
+  std::deque<Frame> window_;
+  double frame_chi2_{0.0};
+  int frame_dof_{0};
+  int frames_since_violation_{0};
+  bool consistent_{false};
+  int64_t violations_{0};
+  double inflation_{0.0};
+};
+
+}  // namespace target
+}  // namespace vimot

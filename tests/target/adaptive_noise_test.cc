@@ -1,0 +1,185 @@
+// AdaptiveNoise (the `adaptive` target mode's σ_t estimate and consistency
+// check) on a filter whose truth is exactly its model: three axes, each a
+// position measured at 20 Hz and a velocity driven by a random walk of known
+// density. The estimate must converge to the true density (also after a
+// step), the adaptive filter must be consistent (NEES), and the check must
+// flag a model violation (a velocity jump) but not a consistent run.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "common/target/adaptive_noise.h"
+
+using vimot::target::AdaptiveNoise;
+using vimot::target::AdaptiveNoiseOptions;
+
+namespace {
+
+constexpr double kDt = 0.05;       // s (20 Hz)
+constexpr double kSigmaMeas = 0.01;  // m
+
+struct Axis {
+  Eigen::Vector2d x_true{0.0, 1.0};  // p, v
+  Eigen::Vector2d x{0.0, 1.0};
+  Eigen::Matrix2d P{Eigen::Vector2d(1e-4, 1e-2).asDiagonal()};
+};
+
+struct RunResult {
+  std::vector<double> sigma;     // σ̂ after each frame
+  std::vector<double> nees;      // Σ over axes of the [p, v] NEES (6 dof)
+  std::vector<bool> consistent;  // the check after each frame
+  int64_t violations{0};
+};
+
+// sigma_true(k): the truth's density at frame k; jump_frame: a velocity jump
+// of 2 m/s on every axis there (a collision: outside any random walk), or -1.
+template <typename SigmaOf>
+RunResult run(uint64_t seed, int frames, double sigma0, SigmaOf sigma_true, int jump_frame = -1) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  AdaptiveNoise est(AdaptiveNoiseOptions{}, sigma0);
+  Axis axes[3];
+  Eigen::Matrix2d F;
+  F << 1.0, kDt, 0.0, 1.0;
+  RunResult out;
+  for (int k = 0; k < frames; ++k) {
+    const double s_true = sigma_true(k);
+    const double s = est.sigma();
+    // Discrete noise of v̇ = n (density s): the exact integrated white noise.
+    Eigen::Matrix2d Q;
+    Q << kDt * kDt * kDt / 3.0, kDt * kDt / 2.0, kDt * kDt / 2.0, kDt;
+    Eigen::VectorXd xm(3), Pm(3), xp(3), Pp(3);
+    double nees = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      Axis& ax = axes[a];
+      // Truth: fine steps of the continuous random walk.
+      const int sub = 10;
+      const double h = kDt / sub;
+      for (int i = 0; i < sub; ++i) {
+        const double dv = s_true * std::sqrt(h) * n01(rng);
+        ax.x_true(0) += (ax.x_true(1) + 0.5 * dv) * h;
+        ax.x_true(1) += dv;
+      }
+      if (k == jump_frame) ax.x_true(1) += 2.0;
+      ax.x = F * ax.x;
+      ax.P = F * ax.P * F.transpose() + s * s * Q;
+      xm(a) = ax.x(1);
+      Pm(a) = ax.P(1, 1);
+      const double z = ax.x_true(0) + kSigmaMeas * n01(rng);
+      const double S = ax.P(0, 0) + kSigmaMeas * kSigmaMeas;
+      const double r = z - ax.x(0);
+      est.add_innovation(r * r / S, 1);
+      const Eigen::Vector2d K = ax.P.col(0) / S;
+      ax.x += K * r;
+      ax.P = (Eigen::Matrix2d::Identity() - K * Eigen::RowVector2d(1.0, 0.0)) * ax.P;
+      xp(a) = ax.x(1);
+      Pp(a) = ax.P(1, 1);
+      const Eigen::Vector2d e = ax.x_true - ax.x;
+      nees += e.dot(ax.P.ldlt().solve(e));
+    }
+    est.end_frame(xm, Pm, xp, Pp, kDt);
+    out.sigma.push_back(est.sigma());
+    out.nees.push_back(nees);
+    out.consistent.push_back(est.consistent());
+  }
+  out.violations = est.violations();
+  return out;
+}
+
+double mean(const std::vector<double>& v, size_t from, size_t to) {
+  double s = 0.0;
+  for (size_t i = from; i < to; ++i) s += v[i];
+  return s / static_cast<double>(to - from);
+}
+
+// √(mean σ̂²): the estimate is of σ², so its spread does not bias this down (Jensen).
+double rms(const std::vector<double>& v, size_t from, size_t to) {
+  double s = 0.0;
+  for (size_t i = from; i < to; ++i) s += v[i] * v[i];
+  return std::sqrt(s / static_cast<double>(to - from));
+}
+
+}  // namespace
+
+TEST_CASE("adaptive noise: the estimate follows a step of the true density", "[adaptive]") {
+  // 0.05 for 120 s, then 0.3 for 120 s; started far below and far above.
+  // From above the matching converges slowly (≈ 50 s from 10× too large: the
+  // position measurements dominate the velocity's corrections), so the
+  // second minute of each phase is compared.
+  const int half = 2400;
+  const auto truth = [&](int k) { return k < half ? 0.05 : 0.3; };
+  for (const double sigma0 : {0.001, 0.5}) {
+    for (uint64_t seed = 1; seed <= 3; ++seed) {
+      const RunResult r = run(seed, 2 * half, sigma0, truth);
+      // Second half of each phase (the window is 2 s; 30 s to settle is ample).
+      const double s1 = rms(r.sigma, half / 2, half);
+      const double s2 = rms(r.sigma, half + half / 2, 2 * half);
+      INFO("sigma0 " << sigma0 << " seed " << seed << ": " << s1 << " (true 0.05), " << s2 << " (true 0.3)");
+      // 20 %: one 2-s window scatters by ±40 % here, and under the feedback
+      // (σ̂ sets the next gains) the low phase reads ≈ 12 % low (measured
+      // 0.041–0.046 over seeds 1–5; docs/target_model.md).
+      CHECK(std::abs(s1 / 0.05 - 1.0) < 0.2);
+      CHECK(std::abs(s2 / 0.3 - 1.0) < 0.2);
+    }
+  }
+}
+
+TEST_CASE("adaptive noise: the adaptive filter is consistent (NEES)", "[adaptive]") {
+  const auto truth = [](int k) { return k < 1200 ? 0.05 : 0.3; };
+  double nees = 0.0;
+  const int runs = 5;
+  for (uint64_t seed = 11; seed < 11 + runs; ++seed) {
+    const RunResult r = run(seed, 2400, 0.01, truth);
+    nees += mean(r.nees, 200, r.nees.size()) / runs;  // after the first 10 s of adaptation
+  }
+  INFO("average NEES of [p, v] × 3 axes (6 dof): " << nees);
+  // The project's band [1.5, 6] for 3 dof, i.e. [0.5, 2] per dof.
+  CHECK(nees > 0.5 * 6);
+  CHECK(nees < 2.0 * 6);
+}
+
+TEST_CASE("adaptive noise: the check flags a model violation, not a consistent run", "[adaptive]") {
+  const auto constant = [](int) { return 0.1; };
+  for (uint64_t seed = 21; seed <= 25; ++seed) {
+    // Consistent: the filter starts at the true density.
+    const RunResult ok = run(seed, 2400, 0.1, constant);
+    CHECK(ok.violations == 0);
+    int coupled = 0;
+    for (bool c : ok.consistent) coupled += c ? 1 : 0;
+    INFO("coupled frames " << coupled << " of 2400");
+    CHECK(coupled >= 2400 - 40);  // all but the first window
+    // A 2 m/s velocity jump at frame 1200: flagged, loosely coupled after it.
+    const RunResult bad = run(seed, 3600, 0.1, constant, 1200);
+    CHECK(bad.violations >= 1);
+    CHECK(bad.consistent[1199]);
+    bool dropped = false;
+    for (int k = 1200; k < 1205; ++k) dropped = dropped || !bad.consistent[k];
+    CHECK(dropped);
+    // and back to tight coupling once the model fits again (σ̂ back down,
+    // from above: slowly, so the third minute is compared).
+    CHECK(bad.consistent.back());
+    CHECK(std::abs(rms(bad.sigma, 2400, 3600) / 0.1 - 1.0) < 0.2);
+  }
+}
+
+TEST_CASE("adaptive noise: bad options are refused", "[adaptive]") {
+  AdaptiveNoiseOptions o;
+  o.window = 1;
+  CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
+  o = AdaptiveNoiseOptions{};
+  o.sigma_max = 0.5 * o.sigma_min;
+  CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
+  o = AdaptiveNoiseOptions{};
+  o.nis_max = 1.0;
+  CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
+  AdaptiveNoise est(AdaptiveNoiseOptions{}, 0.1);
+  CHECK_THROWS_AS(est.end_frame(Eigen::VectorXd(3), Eigen::VectorXd(2), Eigen::VectorXd(3), Eigen::VectorXd(3), kDt),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(est.end_frame(Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1),
+                                Eigen::VectorXd::Zero(1), 0.0),
+                  std::invalid_argument);
+  // The start is clamped into [sigma_min, sigma_max].
+  CHECK(AdaptiveNoise(AdaptiveNoiseOptions{}, 0.0).sigma() == AdaptiveNoiseOptions{}.sigma_min);
+}
