@@ -8,6 +8,7 @@
 #include <ctime>
 #include <cstdlib>
 #include <iostream>
+#include <regex>
 
 #include "common/time/utime.h"
 #include "vimot/heartbeat_t.hpp"
@@ -81,10 +82,18 @@ void add_count(std::vector<std::pair<std::string, int64_t>>* counts, const std::
 
 void Process::add_subscription(
     const std::string& channel, bool literal,
-    std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call, int queue_capacity) {
+    std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call, int queue_capacity,
+    const std::string& exclude_regex) {
   auto sub = std::make_unique<RawSubscription>();
   sub->owner = this;
   sub->decode_and_call = std::move(decode_and_call);
+  if (!exclude_regex.empty()) {
+    try {
+      sub->exclude.emplace(exclude_regex, std::regex::extended | std::regex::nosubs);
+    } catch (const std::regex_error& e) {
+      throw ArgError(name_ + ": bad channel regex to exclude '" + exclude_regex + "': " + e.what());
+    }
+  }
   lcm::Subscription* lcm_sub = lcm_->subscribeFunction(
       channel,
       +[](const lcm::ReceiveBuffer* rbuf, const std::string& chan, RawSubscription* s) {
@@ -96,17 +105,19 @@ void Process::add_subscription(
   if (queue_capacity > 0 && lcm_sub != nullptr) lcm_sub->setQueueCapacity(queue_capacity);
 }
 
-void Process::subscribe_raw(const std::string& channel_regex, RawHandler handler, int queue_capacity) {
+void Process::subscribe_raw(const std::string& channel_regex, RawHandler handler, int queue_capacity,
+                            const std::string& exclude_regex) {
   add_subscription(
       channel_regex, false,
       [handler = std::move(handler)](const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
         handler(channel, rbuf->recv_utime, rbuf->data, static_cast<int>(rbuf->data_size));
         return true;
       },
-      queue_capacity);
+      queue_capacity, exclude_regex);
 }
 
 void Process::handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, RawSubscription* sub) {
+  if (sub->exclude && std::regex_match(channel, *sub->exclude)) return;
   if (counting_left_) {
     add_count(&left_by_channel_, channel, 1);
     return;

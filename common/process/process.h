@@ -24,6 +24,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <regex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -83,8 +84,12 @@ class Process {
   /// The undecoded bytes of every message on the channels matching
   /// `channel_regex` (LCM's regex), with LCM's receive time (wall clock, µs)
   /// and the message's channel: for a logger. Counted per channel as above.
+  /// Channels whose whole name matches `exclude_regex` (POSIX extended, as
+  /// LCM's; empty: none) are skipped and not counted: LCM's regex cannot
+  /// say "all but these". Throws ArgError on a malformed `exclude_regex`.
   using RawHandler = std::function<void(const std::string& channel, int64_t recv_utime, const void* data, int size)>;
-  void subscribe_raw(const std::string& channel_regex, RawHandler handler, int queue_capacity = 0);
+  void subscribe_raw(const std::string& channel_regex, RawHandler handler, int queue_capacity = 0,
+                     const std::string& exclude_regex = "");
 
   template <typename Msg>
   void publish(const std::string& channel, const Msg& msg) {
@@ -158,12 +163,13 @@ class Process {
   struct RawSubscription {
     Process* owner;
     std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call;
+    std::optional<std::regex> exclude;
   };
   /// `literal`: `channel` is one channel, counted ("in <channel>") from 0;
   /// else a regex, whose channels are counted once seen.
   void add_subscription(const std::string& channel, bool literal,
                         std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call,
-                        int queue_capacity);
+                        int queue_capacity, const std::string& exclude_regex = "");
   void update_stream_counters();
   void count_published(const std::string& channel);
   std::vector<std::pair<std::string, int64_t>> in_by_channel_;

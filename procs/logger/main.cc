@@ -13,12 +13,16 @@
 int main(int argc, char** argv) {
   return vimot::run_process_main([&] {
     vimot::Process process("vimot-logger",
-                           "Logs every LCM message (channels matching --channels) to an LCM event log, counting\n"
+                           "Logs every LCM message (channels matching --channels but not --exclude) to an LCM event log, counting\n"
                            "per channel what it logged in its heartbeat and \"stopping:\" line. Stop it with\n"
                            "SIGINT or SIGTERM; with --drain it first logs until the network has been quiet for\n"
                            "--drain-quiet seconds.");
     process.args().add_option("log", "FILE", "LCM log file to write (replaced if it exists; required)");
     process.args().add_option("channels", "REGEX", "channels to log (LCM regex, the whole name)", ".*");
+    process.args().add_option("exclude", "REGEX",
+                              "channels not to log, of those --channels selects (POSIX extended regex, the whole "
+                              "name; e.g. 'PMD_.*|CAM_.*'); not counted",
+                              "");
     // ≈ 100 s of the demo's traffic at 2x real time (≈ 1000 messages/s).
     process.args().add_option("queue", "MESSAGES", "messages held while the logger is busy; more are lost",
                               "100000");
@@ -34,8 +38,10 @@ int main(int argc, char** argv) {
         [&sink](const std::string& channel, int64_t recv_utime, const void* data, int size) {
           sink.write(channel, recv_utime, data, size);
         },
-        static_cast<int>(queue));
-    vimot::log_info("logging ", process.args().get("channels"), " to ", process.args().get("log"));
+        static_cast<int>(queue), process.args().get("exclude"));
+    const std::string exclude = process.args().get("exclude");
+    vimot::log_info("logging ", process.args().get("channels"), exclude.empty() ? "" : " but " + exclude, " to ",
+                    process.args().get("log"));
     return process.run();
   });
 }

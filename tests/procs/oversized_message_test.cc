@@ -478,3 +478,55 @@ TEST_CASE("vimot-logger keeps every message of a burst that overflows a 30-messa
     CHECK(logged.size() < static_cast<std::size_t>(kBurst) / 2);
   }
 }
+
+// vimot-logger --exclude (scripts/record.sh: "everything but procman's own
+// channels and the images", which LCM's regex cannot say): the excluded
+// channels are neither logged nor counted, the match is on the whole name,
+// and a malformed regex is a clear error.
+TEST_CASE("vimot-logger --exclude leaves out exactly the channels whose whole name matches") {
+  VIMOT_SKIP_WITHOUT_MULTICAST();
+  const std::string path = "/tmp/oversized_message_test_" + std::to_string(::getpid()) + "_exclude.lcmlog";
+  const auto [pid, url, log] =
+      launch(VIMOT_LOGGER_BIN, "", {"--log", path, "--exclude", "PMD_.*|CAM_LEFT", "--drain", "10"});
+  lcm::LCM lcm(url);
+  REQUIRE(lcm.good());
+  const std::map<std::string, int> sent{{"IMU", 30}, {"CAM_LEFT", 20}, {"CAM_LEFT2", 10}, {"PMD_INFO", 5}};
+  const uint8_t byte = 7;
+  for (const auto& [channel, count] : sent) {
+    for (int i = 0; i < count; ++i) lcm.publish(channel, &byte, 1);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const std::string out = read_file(log);
+  ::unlink(log.c_str());
+  INFO(out);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  std::map<std::string, int> logged;
+  {
+    lcm::LogFile file(path, "r");
+    REQUIRE(file.good());
+    while (const lcm::LogEvent* ev = file.readNextEvent()) ++logged[ev->channel];
+  }
+  ::unlink(path.c_str());
+  logged.erase("HEARTBEAT");  // the logger's own
+  CHECK(logged == std::map<std::string, int>{{"IMU", 30}, {"CAM_LEFT2", 10}});
+  CHECK(out.find("in CAM_LEFT2 10,") != std::string::npos);
+  CHECK(out.find("in IMU 30") != std::string::npos);
+  CHECK(out.find("in CAM_LEFT ") == std::string::npos);
+  CHECK(out.find("PMD_INFO") == std::string::npos);
+
+  const std::string bad_log = "/tmp/oversized_message_test_" + std::to_string(::getpid()) + "_bad.txt";
+  const std::string command = std::string(VIMOT_LOGGER_BIN) + " --lcm-url '" + url + "' --log " + path +
+                              " --exclude 'CAM_(' > " + bad_log + " 2>&1";
+  const int bad = std::system(command.c_str());
+  const std::string bad_out = read_file(bad_log);
+  ::unlink(bad_log.c_str());
+  ::unlink(path.c_str());
+  INFO(bad_out);
+  CHECK(WIFEXITED(bad));
+  CHECK(WEXITSTATUS(bad) == 1);
+  CHECK(bad_out.find("bad channel regex to exclude 'CAM_('") != std::string::npos);
+}
