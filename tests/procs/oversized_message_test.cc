@@ -27,6 +27,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
@@ -111,6 +112,17 @@ Launched launch(const std::string& exe, const std::string& config, const std::ve
   return Launched{pid, url, log};
 }
 
+// Sends `signal` to a launched process, waits for it and returns its exit
+// status and output (the caller checks them: Catch's INFO is per scope).
+std::pair<int, std::string> stop(pid_t pid, int signal, const std::string& log) {
+  ::kill(pid, signal);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  std::string out = read_file(log);
+  ::unlink(log.c_str());
+  return {status, out};
+}
+
 #define VIMOT_SKIP_WITHOUT_MULTICAST()                                                          \
   if (!multicast_works(private_url())) {                                                         \
     WARN("VIMOT_SKIP: multicast to " << private_url() << " is not delivered on this host");      \
@@ -134,11 +146,7 @@ void check_process(const std::string& exe, const std::string& config) {
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const long rss_kb = peak_rss_kb(pid);
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  const std::string out = read_file(log);
-  ::unlink(log.c_str());
+  const auto [status, out] = stop(pid, SIGTERM, log);
   INFO(exe << "\n" << out);
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
@@ -196,11 +204,7 @@ TEST_CASE("vimot-vins counts lost and future IMU samples in a degraded heartbeat
   }
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(4);
   while (std::chrono::steady_clock::now() < until && (beats.count < 2 || beats.last.messages_in < 95)) lcm.handleTimeout(100);
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  const std::string out = read_file(log);
-  ::unlink(log.c_str());
+  const auto [status, out] = stop(pid, SIGTERM, log);
   INFO(out);
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
@@ -283,11 +287,7 @@ void check_scenario_faults(const std::string& exe, const std::string& config, co
   const int64_t total = sent["IMU"] + sent["FEATURES"] + sent["GROUND_TRUTH"];
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(8);
   while (std::chrono::steady_clock::now() < until && listener.last.messages_in < total) lcm.handleTimeout(100);
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  const std::string out = read_file(log);
-  ::unlink(log.c_str());
+  const auto [status, out] = stop(pid, SIGTERM, log);
   INFO(exe << "\n" << out);
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
@@ -496,11 +496,7 @@ TEST_CASE("vimot-logger --exclude leaves out exactly the channels whose whole na
     for (int i = 0; i < count; ++i) lcm.publish(channel, &byte, 1);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  ::kill(pid, SIGINT);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  const std::string out = read_file(log);
-  ::unlink(log.c_str());
+  const auto [status, out] = stop(pid, SIGINT, log);
   INFO(out);
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
