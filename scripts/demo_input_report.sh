@@ -9,7 +9,9 @@
 # exactly, unless the network itself lost messages at the very end. This
 # covers the logger (vimot-logger counts what it logged per channel); with
 # the run's LCM log also what the log holds against what the logger says.
-# Channels with no counted publisher (HEARTBEAT) are left out.
+# Channels with no counted publisher (HEARTBEAT) are left out; a channel's
+# publishers add up (the rendering simulator says "0 on FEATURES", which the
+# feature tracker publishes).
 #   scripts/demo_input_report.sh SHERIFF_OUTPUT [LCM_LOG]
 # Exits 1 naming each channel whose count is not exact ("NOT COUNTED"),
 # each process that left no "stopping:" line (killed: "NO FINAL COUNT") and
@@ -34,7 +36,7 @@ awk '
   /\[sim\].*INFO: (done|stopped early): / {
     text = $0; sub(/.*INFO: (done|stopped early): /, "", text)
     n = items(text, it)
-    for (i = 1; i <= n; ++i) { split(it[i], w, " "); if (w[2] == "on") { published[w[3]] = w[1]; sim_streams[w[3]] = 1 } }
+    for (i = 1; i <= n; ++i) { split(it[i], w, " "); if (w[2] == "on") { published[w[3]] = w[1] } }
   }
   /INFO: started \(pid/ { name = proc_name(); if (name != "sim" && !(name in started)) { started[name] = 1; order[++np] = name } }
   /INFO: stopping: in / {
@@ -51,7 +53,7 @@ awk '
   }
   END {
     if (length(published) == 0) { print "no \"done:\" line of the simulator: nothing to compare"; exit 1 }
-    for (ch in out_total) if (!(ch in sim_streams)) published[ch] = out_total[ch]
+    for (ch in out_total) published[ch] += out_total[ch]
     status = 0
     for (p = 1; p <= np; ++p) {
       name = order[p]
