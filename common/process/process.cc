@@ -7,7 +7,6 @@
 #include <chrono>
 #include <ctime>
 #include <cstdlib>
-#include <fstream>
 #include <iostream>
 #include <regex>
 
@@ -259,32 +258,16 @@ void Process::drain(const std::function<void()>& idle) {
   // waits: only LCM's receive thread still delivers it (LCM stamps a
   // message when that thread reads it, so time cannot tell a backlog from a
   // source still publishing: the count stops after kCountLimit, and a live
-  // source's last messages then count as lost too). The limit is on time
-  // this thread was not kept off the CPU: a niced process beside CPU hogs
-  // gets ~5 % of a core, and 1 s of wall time then counted only part of a
-  // 14 000-message backlog, leaving the rest lost uncounted.
-  // kCountWallLimit keeps the stop within the sheriff configs' allowance.
-  constexpr int64_t kCountLimitUs = 1000000, kCountWallLimitUs = 4000000;
-  const Clock::time_point count_start = Clock::now();
-  const int64_t count_start_wait_us = thread_runqueue_wait_us();
+  // source's last messages then count as lost too).
+  constexpr auto kCountLimit = std::chrono::seconds(1);
+  const Clock::time_point count_end = Clock::now() + kCountLimit;
   counting_left_ = true;
-  while (lcm_->handleTimeout(50) > 0) {
-    const int64_t wall_us = std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - count_start).count();
-    if (wall_us >= kCountWallLimitUs) break;
-    if (wall_us - (thread_runqueue_wait_us() - count_start_wait_us) >= kCountLimitUs) break;
+  while (Clock::now() < count_end && lcm_->handleTimeout(50) > 0) {
   }
   counting_left_ = false;
   for (const auto& [channel, n] : left_by_channel_) {
     report_lost(n, std::to_string(n) + " message(s) on " + channel + " still queued when stopped", channel);
   }
-}
-
-int64_t thread_runqueue_wait_us() {
-  // schedstat: time on the CPU, time waiting on a run queue (ns), time slices.
-  std::ifstream in("/proc/thread-self/schedstat");
-  long long on_cpu_ns = 0, waiting_ns = 0;
-  if (!(in >> on_cpu_ns >> waiting_ns)) return 0;
-  return waiting_ns / 1000;
 }
 
 int run_process_main(const std::function<int()>& body) {

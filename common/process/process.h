@@ -191,10 +191,6 @@ void Process::subscribe(const std::string& channel, std::function<void(const Msg
       queue_capacity);
 }
 
-/// Time the calling thread has spent runnable but waiting for a CPU (µs,
-/// Linux schedstat; 0 where unavailable): how long the scheduler kept it off.
-int64_t thread_runqueue_wait_us();
-
 /// Runs a process main, turning any escaping exception into a one-line error
 /// and exit code 1 (bad arguments and configs are the common case).
 int run_process_main(const std::function<int()>& body);
