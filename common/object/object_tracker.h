@@ -62,6 +62,10 @@ struct ObjectTrackerOptions {
   // The initialisation commits to one of the two (Necker) structures only if
   // the other's cost over the buffer is larger by this chi-square margin.
   double init_min_chi2_gap{25.0};
+  // ... and only if its points are this far from one plane (smallest over
+  // middle principal extent): the points of one face of a small object
+  // admit a continuous family of structures, not just the reversed one.
+  double init_min_thickness{0.2};
   double ransac_threshold_px{1.5};      // px, essential matrix and PnP RANSAC
   int reference_features{5};            // features nearest the centre ray that define depth 1
   int min_track_features{10};           // fewer BA features in a frame: track lost
