@@ -12,7 +12,9 @@
 // whose structure is a family, not the pair of Necker hypotheses. The
 // tracker then used to commit to a wrong member (79 deg at the first valid
 // frame, 0.05 px RMS); its thickness gate (init_min_thickness) now refuses
-// to initialise on it (docs/object_tracker.md, "Initialisation").
+// to initialise on it (docs/object_tracker.md, "Initialisation"). Not
+// enough yet: on seed 2 a wrong structure passes the gate after 5 s
+// (docs/object_tracker.md, "Open issues").
 #include <catch2/catch.hpp>
 
 #include <cmath>
