@@ -30,7 +30,9 @@
 // depths, the frames in between are posed by PnP and all go through a BA. A
 // small object projects almost affinely, so the depth-reversed structure is
 // solved too; the tracker commits only if one is clearly cheaper
-// (`init_min_chi2_gap`), else the buffer slides on.
+// (`init_min_chi2_gap`) and its points are not nearly planar
+// (`init_min_thickness`: one face admits a family of structures), else the
+// buffer slides on.
 //
 // Internally poses are Ceres parameter blocks (Eigen::Quaterniond, whose
 // coefficient order x y z w is what EigenQuaternionManifold expects); they
