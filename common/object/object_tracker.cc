@@ -8,6 +8,7 @@
 #include <set>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
 #include <ceres/ceres.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -96,6 +97,21 @@ Eigen::Vector3d centre_ray(const std::vector<FeatureObservation>& target, const 
   return homogeneous(n).normalized();
 }
 
+// How far the points are from lying on one plane: the smallest over the
+// middle principal standard deviation of their positions (0 planar, 1 as
+// thick as wide).
+template <typename Features>
+double structure_thickness(const Features& features) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& [id, f] : features) mean += f.p_FinO;
+  mean /= static_cast<double>(features.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& [id, f] : features) scatter += (f.p_FinO - mean) * (f.p_FinO - mean).transpose();
+  // Ascending.
+  const Eigen::Vector3d eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+  return eigenvalues(1) > 0.0 ? std::sqrt(std::max(eigenvalues(0), 0.0) / eigenvalues(1)) : 0.0;
+}
+
 }  // namespace
 
 ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
@@ -104,9 +120,9 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   if (!config.has("object_tracker")) return o;
   config.check_keys("object_tracker",
                     {"window_size", "focal_length_px", "robust_loss", "robust_loss_px", "min_init_features",
-                     "min_init_parallax_deg", "init_frames", "init_min_chi2_gap", "ransac_threshold_px",
-                     "reference_features", "min_track_features", "max_reprojection_rms_px", "outlier_threshold_px",
-                     "min_feature_parallax_deg", "min_feature_observations", "max_iterations",
+                     "min_init_parallax_deg", "init_frames", "init_min_chi2_gap", "init_min_thickness",
+                     "ransac_threshold_px", "reference_features", "min_track_features", "max_reprojection_rms_px",
+                     "outlier_threshold_px", "min_feature_parallax_deg", "min_feature_observations", "max_iterations",
                      "keyframe_rotation_deg", "keyframe_baseline", "reassociation_px", "max_retired_poses"});
   const Config c = config.sub("object_tracker");
   o.window_size = c.get_or<int>("window_size", o.window_size);
@@ -117,6 +133,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   o.min_init_parallax_deg = c.get_or<double>("min_init_parallax_deg", o.min_init_parallax_deg);
   o.init_frames = c.get_or<int>("init_frames", o.init_frames);
   o.init_min_chi2_gap = c.get_or<double>("init_min_chi2_gap", o.init_min_chi2_gap);
+  o.init_min_thickness = c.get_or<double>("init_min_thickness", o.init_min_thickness);
   o.ransac_threshold_px = c.get_or<double>("ransac_threshold_px", o.ransac_threshold_px);
   o.reference_features = c.get_or<int>("reference_features", o.reference_features);
   o.min_track_features = c.get_or<int>("min_track_features", o.min_track_features);
@@ -138,6 +155,7 @@ ObjectTrackerOptions object_tracker_options_from_config(const Config& config) {
   require(o.init_frames >= 2, "init_frames", "must be >= 2");
   require(o.reassociation_px >= 0.0, "reassociation_px", "must be >= 0");
   require(o.init_min_chi2_gap >= 0.0, "init_min_chi2_gap", "must be >= 0");
+  require(o.init_min_thickness >= 0.0 && o.init_min_thickness <= 1.0, "init_min_thickness", "must be in [0, 1]");
   require(o.min_init_features >= 8, "min_init_features", "must be >= 8");
   require(o.reference_features >= 1, "reference_features", "must be >= 1");
   require(o.min_track_features >= 4, "min_track_features", "must be >= 4");
@@ -341,6 +359,10 @@ ObjectPoseEstimate ObjectTracker::try_initialise(InitFrame frame) {
     window_ = kept_window;
   }
   if (static_cast<int>(features_.size()) < options_.min_init_features) return invalid;
+  // Points on (nearly) one plane, e.g. one face of the box, admit a family
+  // of structures under the near-affine view, not just the two above: wait
+  // for points off that plane.
+  if (structure_thickness(features_) < options_.init_min_thickness) return invalid;
 
   // Fig. 5: the surface along the centre ray is at the median distance of
   // the features angularly nearest to the ray; that distance becomes 1.

@@ -30,7 +30,9 @@
 // depths, the frames in between are posed by PnP and all go through a BA. A
 // small object projects almost affinely, so the depth-reversed structure is
 // solved too; the tracker commits only if one is clearly cheaper
-// (`init_min_chi2_gap`), else the buffer slides on.
+// (`init_min_chi2_gap`) and its points are not nearly planar
+// (`init_min_thickness`: one face admits a family of structures), else the
+// buffer slides on.
 //
 // Internally poses are Ceres parameter blocks (Eigen::Quaterniond, whose
 // coefficient order x y z w is what EigenQuaternionManifold expects); they
@@ -62,6 +64,10 @@ struct ObjectTrackerOptions {
   // The initialisation commits to one of the two (Necker) structures only if
   // the other's cost over the buffer is larger by this chi-square margin.
   double init_min_chi2_gap{25.0};
+  // ... and only if its points are this far from one plane (smallest over
+  // middle principal extent): the points of one face of a small object
+  // admit a continuous family of structures, not just the reversed one.
+  double init_min_thickness{0.2};
   double ransac_threshold_px{1.5};      // px, essential matrix and PnP RANSAC
   int reference_features{5};            // features nearest the centre ray that define depth 1
   int min_track_features{10};           // fewer BA features in a frame: track lost

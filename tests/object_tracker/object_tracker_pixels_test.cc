@@ -6,11 +6,15 @@
 // from the renderer's ray cast of its reference features
 // (eval::object_truth_from_pixels), so nothing here uses the simulator's
 // feature ids. The metric scale needs a 40 s window: its figures are
-// vimot-scale-eval --pixels (docs/scale_estimator.md). The pose accuracy from
-// pixels is not yet met and is reported there, not here: the target tracks
-// are now accurate (anchored, eval_tracker_accuracy_test), but the
-// initialisation settles on a wrong structure (79 deg at the first valid
-// frame with 0.1 px reprojection RMS, docs/scale_estimator.md).
+// vimot-scale-eval --pixels (docs/scale_estimator.md). From pixels nearly
+// all target points lie on the box's top face (the shaded side faces give
+// the front end few corners): a planar point set under a near-affine view,
+// whose structure is a family, not the pair of Necker hypotheses. The
+// tracker then used to commit to a wrong member (79 deg at the first valid
+// frame, 0.05 px RMS); its thickness gate (init_min_thickness) now refuses
+// to initialise on it (docs/object_tracker.md, "Initialisation"). Not
+// enough yet: on seed 2 a wrong structure passes the gate after 5 s
+// (docs/object_tracker.md, "Open issues").
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -40,6 +44,7 @@ struct PixelRun {
   double position_rms_m{0.0};         // s_true pbar_OinC against the true p_OinC
   double position_max_m{0.0};
   double rotation_rms_deg{0.0};
+  double rotation_max_deg{0.0};
 };
 
 // 6 s of config/sim_mono.yaml from pixels through the node, as the LCM chain.
@@ -99,6 +104,7 @@ PixelRun run_from_pixels() {
     run.position_max_m = std::max(run.position_max_m, pos);
     const double rot = rotation_angle_between(quat_to_rot(pose.q_OtoC), truth.R_OtoC(x));
     sum_rot2 += rot * rot;
+    run.rotation_max_deg = std::max(run.rotation_max_deg, rot * 180.0 / M_PI);
   }
   run.tracks = static_cast<int>(truths.size());
   if (run.valid > 0) {
@@ -115,17 +121,19 @@ const PixelRun& pixel_run() {
 
 }  // namespace
 
-TEST_CASE("object tracker from rendered pixels: a track starts and holds, its centre ray from the box",
-          "[object_tracker][pixels]") {
+TEST_CASE("object tracker from rendered pixels: no track on a wrong structure", "[object_tracker][pixels]") {
   const PixelRun& run = pixel_run();
   INFO("valid " << run.valid << " of " << run.frames_after_init << " frames after the first initialisation, "
                 << run.tracks << " tracks; centre ray vs the box centre's ray " << run.centre_ray_error_deg
-                << " deg; pose against truth (reported, not yet bounded): position RMS " << run.position_rms_m
-                << " m (max " << run.position_max_m << "), rotation RMS " << run.rotation_rms_deg << " deg");
-  // The 40-frame initialisation buffer (2 s) fills, then the track holds.
-  CHECK(run.tracks == 1);
+                << " deg; pose against truth: position RMS " << run.position_rms_m << " m (max "
+                << run.position_max_m << "), rotation RMS " << run.rotation_rms_deg << " deg (max "
+                << run.rotation_max_deg << ")");
+  // Every pose the tracker gives is right (no gross error, as the
+  // feature-level tests' 5 deg); a track, if one starts, holds.
+  CHECK(run.rotation_max_deg < 5.0);
   CHECK(run.valid == run.frames_after_init);
-  CHECK(run.valid >= 60);
-  CHECK(run.centre_ray_error_deg >= 0.0);
-  CHECK(run.centre_ray_error_deg < 0.2);  // 1.6 px at f = 458 px
+  if (run.tracks > 0) {
+    CHECK(run.centre_ray_error_deg >= 0.0);
+    CHECK(run.centre_ray_error_deg < 0.2);  // 1.6 px at f = 458 px
+  }
 }
