@@ -127,6 +127,9 @@ export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0&recv_
 out="${VIMOT_OUT:-$here/out/demo-$(date +%Y%m%d-%H%M%S)}"
 mkdir -p "$out"
 export VIMOT_LOG="$out/demo.lcmlog"
+# The estimators' checkpoints (sim_demo.pmd), rewritten after every update:
+# on a RAM file system, off the disk the log is written to; removed at the end.
+export VIMOT_CKPT="/dev/shm/vimot-demo-$$"
 
 echo "== vimot demo: $VIMOT_SIM_CONFIG at ${VIMOT_SPEED}x real time, seed $VIMOT_SEED"
 echo "== processes ($(basename "$pmd")):"
@@ -136,6 +139,7 @@ set +e
 "$VIMOT_BIN/vimot-sheriff" --script run --exit-when sim "$pmd" > "$out/sheriff.txt" 2>&1
 status=$?
 set -e
+rm -f "$VIMOT_CKPT".*.ckpt "$VIMOT_CKPT".*.ckpt.tmp
 grep -E '\[sim\].*(scenario|done|stopped)' "$out/sheriff.txt" | sed 's/^/   /' || true
 if [ $status -ne 0 ]; then
   echo "demo: the sheriff exited with status $status; last lines of $out/sheriff.txt:" >&2

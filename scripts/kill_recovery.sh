@@ -12,7 +12,7 @@
 #               never fell silent for more than 1 s;
 #   kept        the estimate survived: a killed vins or target_filter
 #               restored its robot state from its checkpoint (--checkpoint
-#               in sim_demo.pmd), after a simulator kill both estimators
+#               in sim_demo.pmd, under /dev/shm), after a simulator kill both estimators
 #               bridged the outage; neither reset;
 #   accuracy    position RMSE (vimot-log-eval: every updated state of the
 #               run against the ground truth; the target in the world and
@@ -74,6 +74,7 @@ cleanup() {
   local p
   for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
   for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  rm -f /dev/shm/vimot-kill-recovery-$$-*
 }
 trap cleanup EXIT
 
@@ -99,6 +100,9 @@ run() {
   local name="$1" victim="${2:-}" dir="$out/$1"
   mkdir -p "$dir"
   export VIMOT_LOG="$dir/run.lcmlog"
+  # Checkpoints on a RAM file system: rewritten after every update, they
+  # must not compete with the log's disk writes (docs/sheriff.md).
+  export VIMOT_CKPT="/dev/shm/vimot-kill-recovery-$$-$name"
   local sheriff deputy=""
   : > "$dir/sheriff.txt"
   if [ $mode = local ]; then
@@ -136,6 +140,7 @@ run() {
   wait "$sheriff" || true
   if [ -n "$deputy" ]; then kill -INT "$deputy" 2>/dev/null || true; wait "$deputy" || true; fi
   pids=()
+  rm -f "$VIMOT_CKPT".*.ckpt "$VIMOT_CKPT".*.ckpt.tmp
   "$bin/vimot-log-summary" --gaps "$VIMOT_LOG" > "$dir/summary.txt" || true
   # The target's frame is taken again where TARGET_STATE paused, but not
   # after a simulator kill: there the target filter keeps its target.
