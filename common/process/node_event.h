@@ -17,4 +17,7 @@ struct NodeEvent {
   std::string stream{};  // kLost: which input stream (IMU, FEATURES, GROUND_TRUTH)
 };
 
+/// The input streams of an estimator node (run_estimator_node).
+enum class EstimatorInput { kImu, kFrame, kGroundTruth };
+
 }  // namespace vimot

@@ -44,23 +44,25 @@ int run_estimator_node(Process& process, Node& node, bool use_ground_truth, doub
   // CPU (LCM's default queue, 30 messages, is 0.15 s of IMU): the demo's
   // whole run, so what a process that fell behind still holds at the stop
   // is drained or counted (Process, --drain). A queue that overflows loses
-  // messages silently; the stream's next message shows the gap, but not
-  // after its last one.
+  // messages silently; the stream's next message, handled or left at the
+  // stop, shows the gap, but not after its last one.
   constexpr int kImuQueue = 24000, kFeaturesQueue = 1200;
+  using Input = EstimatorInput;
   process.subscribe<imu_t>(
       process.channel("imu", "IMU"),
       [&](const imu_t& m) {
         node.on_imu(from_lcm(m));
         last_imu_wall = Clock::now();  // after the frames this sample released were processed
       },
-      kImuQueue);
+      kImuQueue, [&](const imu_t& m) { node.count_left(Input::kImu, m.utime); });
   process.subscribe<features_t>(
       process.channel("features", "FEATURES"), [&](const features_t& m) { node.on_frame(from_lcm(m)); },
-      kFeaturesQueue);
+      kFeaturesQueue, [&](const features_t& m) { node.count_left(Input::kFrame, m.utime); });
   if (use_ground_truth) {
     process.subscribe<ground_truth_t>(
         process.channel("ground_truth", "GROUND_TRUTH"),
-        [&](const ground_truth_t& m) { node.on_ground_truth(from_lcm(m)); }, kImuQueue);
+        [&](const ground_truth_t& m) { node.on_ground_truth(from_lcm(m)); }, kImuQueue,
+        [&](const ground_truth_t& m) { node.count_left(Input::kGroundTruth, m.utime); });
   }
   log_info(use_ground_truth ? "waiting for GROUND_TRUTH to initialise" : "initialising at rest from the IMU");
   const int status = process.run([&] {

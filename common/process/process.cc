@@ -80,13 +80,12 @@ void add_count(std::vector<std::pair<std::string, int64_t>>* counts, const std::
 }
 }  // namespace
 
-void Process::add_subscription(
-    const std::string& channel, bool literal,
-    std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call, int queue_capacity,
-    const std::string& exclude_regex) {
+void Process::add_subscription(const std::string& channel, bool literal, DecodeAndCall decode_and_call,
+                               int queue_capacity, const std::string& exclude_regex, DecodeAndCall decode_left) {
   auto sub = std::make_unique<RawSubscription>();
   sub->owner = this;
   sub->decode_and_call = std::move(decode_and_call);
+  sub->decode_left = std::move(decode_left);
   if (!exclude_regex.empty()) {
     try {
       sub->exclude.emplace(exclude_regex, std::regex::extended | std::regex::nosubs);
@@ -120,6 +119,13 @@ void Process::handle_raw(const lcm::ReceiveBuffer* rbuf, const std::string& chan
   if (sub->exclude && std::regex_match(channel, *sub->exclude)) return;
   if (counting_left_) {
     add_count(&left_by_channel_, channel, 1);
+    if (sub->decode_left) {
+      try {
+        sub->decode_left(rbuf, channel);  // one that does not decode is counted above all the same
+      } catch (const std::exception& e) {
+        report_error("counting what is left on " + channel + ": " + e.what());
+      }
+    }
     return;
   }
   add_count(&in_by_channel_, channel, 1);

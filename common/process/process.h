@@ -78,8 +78,12 @@ class Process {
   /// `queue_capacity`: messages LCM holds for this channel while the handler
   /// thread is busy; LCM silently drops what comes beyond (0: LCM's
   /// default, 30 — 0.15 s of a 200 Hz stream).
+  /// `on_left` (optional) sees each message still queued at the stop, which
+  /// is counted lost unhandled: the node can count the gaps between those
+  /// messages too (loss inside a backlog is otherwise invisible).
   template <typename Msg>
-  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity = 0);
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity = 0,
+                 std::function<void(const Msg&)> on_left = {});
 
   /// The undecoded bytes of every message on the channels matching
   /// `channel_regex` (LCM's regex), with LCM's receive time (wall clock, µs)
@@ -159,17 +163,19 @@ class Process {
   std::vector<std::pair<std::string, int64_t>> left_by_channel_;
 
   // Subscriptions keep their closures alive for the LCM callbacks.
-  // `decode_and_call` returns false for a message that does not decode.
+  // `decode_and_call` returns false for a message that does not decode;
+  // `decode_left` (may be empty) takes a message left at the stop.
+  using DecodeAndCall = std::function<bool(const lcm::ReceiveBuffer*, const std::string&)>;
   struct RawSubscription {
     Process* owner;
-    std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call;
+    DecodeAndCall decode_and_call;
+    DecodeAndCall decode_left;
     std::optional<std::regex> exclude;
   };
   /// `literal`: `channel` is one channel, counted ("in <channel>") from 0;
   /// else a regex, whose channels are counted once seen.
-  void add_subscription(const std::string& channel, bool literal,
-                        std::function<bool(const lcm::ReceiveBuffer*, const std::string&)> decode_and_call,
-                        int queue_capacity, const std::string& exclude_regex = "");
+  void add_subscription(const std::string& channel, bool literal, DecodeAndCall decode_and_call, int queue_capacity,
+                        const std::string& exclude_regex = "", DecodeAndCall decode_left = {});
   void update_stream_counters();
   void count_published(const std::string& channel);
   std::vector<std::pair<std::string, int64_t>> in_by_channel_;
@@ -179,16 +185,18 @@ class Process {
 };
 
 template <typename Msg>
-void Process::subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity) {
-  add_subscription(
-      channel, true,
-      [handler = std::move(handler)](const lcm::ReceiveBuffer* rbuf, const std::string&) {
-        Msg msg;
-        if (!decode_untrusted(rbuf->data, static_cast<int>(rbuf->data_size), &msg)) return false;
-        handler(msg);  // exceptions here are the handler's: counted as errors
-        return true;
-      },
-      queue_capacity);
+void Process::subscribe(const std::string& channel, std::function<void(const Msg&)> handler, int queue_capacity,
+                        std::function<void(const Msg&)> on_left) {
+  const auto decoding = [](std::function<void(const Msg&)> call) -> DecodeAndCall {
+    if (!call) return {};
+    return [call = std::move(call)](const lcm::ReceiveBuffer* rbuf, const std::string&) {
+      Msg msg;
+      if (!decode_untrusted(rbuf->data, static_cast<int>(rbuf->data_size), &msg)) return false;
+      call(msg);  // exceptions here are the handler's: counted as errors
+      return true;
+    };
+  };
+  add_subscription(channel, true, decoding(std::move(handler)), queue_capacity, "", decoding(std::move(on_left)));
 }
 
 /// Runs a process main, turning any escaping exception into a one-line error

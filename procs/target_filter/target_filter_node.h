@@ -90,6 +90,8 @@ class TargetFilterNode {
   void on_ground_truth(const GroundTruth& truth);
   /// Processes every queued frame with the IMU data there is.
   void flush();
+  /// See VinsNode::count_left.
+  void count_left(EstimatorInput input, int64_t utime) { vins_.count_left(input, utime); }
   /// The robot part (VinsNode): resets, bridged gaps, restore.
   const VinsNode& vins() const { return vins_; }
 

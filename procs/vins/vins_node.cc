@@ -188,6 +188,16 @@ bool VinsNode::admit(StreamGuard& guard, int64_t utime) {
   return false;
 }
 
+void VinsNode::count_left(EstimatorInput input, int64_t utime) {
+  StreamGuard& guard = input == EstimatorInput::kImu     ? imu_guard_
+                       : input == EstimatorInput::kFrame ? frame_guard_
+                                                         : truth_guard_;
+  const StreamCheck c = guard.check(utime);
+  if (c.lost > 0 && on_event_) {
+    on_event_(NodeEvent{NodeEvent::Kind::kLost, c.message + " (in the input left at the stop)", c.lost, guard.name()});
+  }
+}
+
 void VinsNode::on_imu(const ImuData& imu) {
   guarded("on_imu", [&] { on_imu_checked(imu); });
 }

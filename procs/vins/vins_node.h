@@ -132,6 +132,10 @@ class VinsNode {
   bool on_ground_truth(const GroundTruth& truth, GroundTruth* accepted = nullptr);
   /// Processes every queued frame with the IMU data there is.
   void flush();
+  /// A message of `input` left unhandled at the stop (the process counts it
+  /// lost): the messages missing before it, after the last handled or left
+  /// one, are counted lost as a gap between handled messages is.
+  void count_left(EstimatorInput input, int64_t utime);
 
   /// Lets an extension of the process (the target filter) act around each
   /// frame: `before_frame` runs before the estimator sees a frame,

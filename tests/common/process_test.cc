@@ -151,6 +151,23 @@ TEST_CASE("input queued at the stop is drained with --drain, else counted as los
   CHECK(got.status == (drain ? "ok" : "degraded"));
 }
 
+TEST_CASE("a message left at the stop reaches the subscription's on_left, unhandled, in order") {
+  auto p = make_process({"--drain", "0"});
+  int handled = 0;
+  std::vector<int64_t> left;
+  p->subscribe<vimot::imu_t>(
+      "IMU", [&](const vimot::imu_t&) { ++handled; }, 0, [&](const vimot::imu_t& m) { left.push_back(m.utime); });
+  vimot::imu_t m{};
+  for (const int64_t utime : {10, 20, 40, 50}) {
+    m.utime = utime;
+    p->publish("IMU", m);
+  }
+  p->stop();
+  CHECK(p->run() == 0);
+  CHECK(handled == 0);
+  CHECK(left == std::vector<int64_t>{10, 20, 40, 50});
+}
+
 TEST_CASE("--drain and --drain-quiet must be non-negative seconds") {
   for (const char* bad : {"-1", "x"}) {
     Process p("test-proc", "x");
