@@ -1,17 +1,16 @@
 // Consistency of the target filter (issue 15 item 3): with the shipped
 // configs (config/target_filter.yaml: target started from its own features,
-// observability constraint on) the mean target-in-IMU NEES of a few runs
-// stays in the band [1.5, 6] (3 is ideal for 3 dof; below the band the
-// filter claims too little, above it too much), position and orientation,
-// local and global SKF, at the small and the large end of the σ_t range the
-// band is asked for; so does the target's orientation in the world. The
-// target's position in the world is the robot's position plus the target in
-// the IMU: its NEES follows the robot's (VIO's) own, which reads low on
-// these short runs (≈ 1.9), so it is reported, not checked. The target is the
-// paper's constant-speed semicircle, so every σ_t there is a right model.
-// The filter before issue 15 (no observability constraint, gauge prior
-// 0.01) fails it: run with env TARGET_CONFIG=<a copy of the config with
-// those settings> (docs/evaluation.md, "Target NEES band").
+// observability constraint off) the mean target NEES of three whole runs of
+// the semicircle (104.7 s) stays in the band [1.5, 6] (3 is ideal for 3 dof;
+// below the band the filter claims too little, above it too much): position
+// and orientation of the target in the IMU and in the world, local and
+// global SKF, at the small and the large end of the σ_t range the band is
+// asked for. The target is the paper's constant-speed semicircle, so every
+// σ_t there is a right model. Whole runs because the over-confidence of the
+// observability-constrained filter (the target's roll about its heading)
+// grows with the run's length and passes 40-s runs: run with env
+// TARGET_CONFIG=<a copy of the config with observability_constraint: true>
+// to see it fail (docs/evaluation.md, "Target NEES band").
 #include <catch2/catch.hpp>
 
 #include <cstdlib>
@@ -31,12 +30,10 @@ namespace {
 
 std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
 
-constexpr double kDuration = 40.0;  // [s] of the semicircle
 constexpr int kRuns = 3;
 
 std::vector<TargetCell> sweep(const target::TargetFilterOptions& filter) {
   sim::SimConfig sim_cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
-  sim_cfg.duration = kDuration;
   const estimator::VioOptions vo = estimator::load_vio_options(source_path("config/vins.yaml"));
   TargetSweepOptions o;
   o.sigmas = {0.01, 0.1};
@@ -64,6 +61,7 @@ bool all_in_band(const std::vector<TargetCell>& cells) {
     CHECK(s.runs == kRuns);
     const bool cell_ok = in_band(s.target_in_imu.nees_position.mean) &&
                          in_band(s.target_in_imu.nees_orientation.mean) &&
+                         in_band(s.target_in_world.nees_position.mean) &&
                          in_band(s.target_in_world.nees_orientation.mean);
     CHECK(cell_ok);  // reported per cell (INFO above) before the overall verdict
     ok = ok && cell_ok;
@@ -73,7 +71,7 @@ bool all_in_band(const std::vector<TargetCell>& cells) {
 
 }  // namespace
 
-TEST_CASE("target NEES in [1.5, 6] with the shipped config, local and global SKF, σ_t 0.01 and 0.1",
+TEST_CASE("whole-run target NEES in [1.5, 6] with the shipped config, local and global SKF, σ_t 0.01 and 0.1",
           "[target_filter][consistency]") {
   const char* other = std::getenv("TARGET_CONFIG");
   const target::TargetFilterOptions filter =
