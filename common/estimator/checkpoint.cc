@@ -350,10 +350,10 @@ bool read_checkpoint(const std::string& path, EstimatorCheckpoint* checkpoint, s
     dim += v.size;
   }
   if (!r.ok() || !sizes) return reject("variables cut short or of impossible sizes");
+  const std::size_t cov_bytes = static_cast<std::size_t>(dim * dim) * sizeof(double);
+  if (r.left() < cov_bytes) return reject("too short for the " + std::to_string(dim) + "-square covariance");
   c.covariance.resize(dim, dim);
-  if (!r.take_raw(c.covariance.data(), static_cast<std::size_t>(dim * dim) * sizeof(double))) {
-    return reject("too short for the " + std::to_string(dim) + "-square covariance");
-  }
+  r.take_raw(c.covariance.data(), cov_bytes);
   c.tracks = r.take_tracks();
   c.has_extension = r.take<uint8_t>() != 0;
   c.extension = r.take_string();

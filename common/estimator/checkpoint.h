@@ -91,6 +91,7 @@ class CheckpointReader {
   FeatureDatabase take_tracks();
   bool ok() const { return ok_; }
   bool at_end() const { return at_ == end_; }
+  std::size_t left() const { return static_cast<std::size_t>(end_ - at_); }
 
  private:
   bool need(std::size_t n);
