@@ -55,6 +55,9 @@ class FeatureDatabase {
   void clean_older_than(int64_t utime);
   void clear() { features_.clear(); }
   size_t size() const { return features_.size(); }
+  /// Every track by feature id (a checkpoint's), and one put back as it was.
+  const std::map<int64_t, std::shared_ptr<Feature>>& features() const { return features_; }
+  void insert(const Feature& feature) { features_[feature.feature_id] = std::make_shared<Feature>(feature); }
 
  private:
   std::map<int64_t, std::shared_ptr<Feature>> features_;

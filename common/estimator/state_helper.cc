@@ -379,6 +379,23 @@ int StateHelper::marginalize_flagged_slam(State& state) {
   return count;
 }
 
+void StateHelper::restore_layout(State& state, const std::vector<TypePtr>& variables, const Eigen::MatrixXd& cov,
+                                 std::map<int64_t, std::shared_ptr<PoseJPL>> clones,
+                                 std::map<int64_t, std::shared_ptr<Landmark>> slam) {
+  int id = 0;
+  for (const TypePtr& v : variables) {
+    v->set_local_id(id);
+    id += v->size();
+  }
+  if (id != cov.rows() || cov.rows() != cov.cols()) {
+    throw std::invalid_argument("StateHelper::restore_layout: covariance is not " + std::to_string(id) + " square");
+  }
+  state.variables_ = variables;
+  state.cov_ = cov;
+  state.clones_ = std::move(clones);
+  state.slam_ = std::move(slam);
+}
+
 void StateHelper::reset_imu(State& state, const ImuValue& value, const Eigen::Matrix<double, 15, 15>& P_imu) {
   const Eigen::VectorXd x = value.to_vector();
   state.imu_->set_value(x);

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -106,6 +107,13 @@ class StateHelper {
 
   /// Marginalises every SLAM landmark flagged should_marginalize.
   static int marginalize_flagged_slam(State& state);
+
+  /// Lays out a fresh state (only its IMU) as a checkpoint's: `variables`
+  /// (containing state.imu()) in that order, `cov` their covariance, and
+  /// which of them are clones (by utime) and SLAM landmarks.
+  static void restore_layout(State& state, const std::vector<TypePtr>& variables, const Eigen::MatrixXd& cov,
+                             std::map<int64_t, std::shared_ptr<PoseJPL>> clones,
+                             std::map<int64_t, std::shared_ptr<Landmark>> slam);
 
   /// Overwrites the IMU estimate (value and FEJ), its covariance block and
   /// zeroes its correlations; used by initialisation and reset.

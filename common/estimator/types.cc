@@ -58,6 +58,14 @@ void JplQuat::set_fej(const Eigen::VectorXd& fej) {
   R_fej_ = quat_to_rot(Eigen::Vector4d(fej_));
 }
 
+void JplQuat::set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) {
+  check_size(value, 4, "JplQuat::set_exact");
+  check_size(fej, 4, "JplQuat::set_exact");
+  Type::set_exact(value, fej);
+  R_ = quat_to_rot(Eigen::Vector4d(value_));
+  R_fej_ = quat_to_rot(Eigen::Vector4d(fej_));
+}
+
 std::shared_ptr<Type> JplQuat::clone_type() const {
   auto c = std::make_shared<JplQuat>();
   c->set_value(value_);
@@ -101,6 +109,14 @@ void PoseJPL::set_fej(const Eigen::VectorXd& fej) {
   p_->set_fej(fej.tail<3>());
   fej_.resize(7);
   fej_ << q_->fej(), p_->fej();
+}
+
+void PoseJPL::set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) {
+  check_size(value, 7, "PoseJPL::set_exact");
+  check_size(fej, 7, "PoseJPL::set_exact");
+  q_->set_exact(value.head<4>(), fej.head<4>());
+  p_->set_exact(value.tail<3>(), fej.tail<3>());
+  Type::set_exact(value, fej);
 }
 
 std::shared_ptr<Type> PoseJPL::clone_type() const {
@@ -188,6 +204,16 @@ void ImuState::set_value(const Eigen::VectorXd& value) {
   ba_->set_value(value.segment<3>(13));
   value_.resize(16);
   value_ << pose_->value(), v_->value(), bg_->value(), ba_->value();
+}
+
+void ImuState::set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) {
+  check_size(value, 16, "ImuState::set_exact");
+  check_size(fej, 16, "ImuState::set_exact");
+  pose_->set_exact(value.head<7>(), fej.head<7>());
+  v_->set_exact(value.segment<3>(7), fej.segment<3>(7));
+  bg_->set_exact(value.segment<3>(10), fej.segment<3>(10));
+  ba_->set_exact(value.segment<3>(13), fej.segment<3>(13));
+  Type::set_exact(value, fej);
 }
 
 void ImuState::set_fej(const Eigen::VectorXd& fej) {

@@ -44,6 +44,12 @@ class Type {
   const Eigen::VectorXd& fej() const { return fej_; }
   virtual void set_value(const Eigen::VectorXd& value) { value_ = value; }
   virtual void set_fej(const Eigen::VectorXd& fej) { fej_ = fej; }
+  /// Value and fej exactly as given (a checkpoint's, checkpoint.h): no
+  /// re-normalisation, which would change the last bits of a quaternion.
+  virtual void set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) {
+    value_ = value;
+    fej_ = fej;
+  }
 
   /// A deep copy of value and fej, not in the state (id -1).
   virtual std::shared_ptr<Type> clone_type() const = 0;
@@ -75,6 +81,7 @@ class JplQuat : public Type {
   void update(const Eigen::VectorXd& dx) override;
   void set_value(const Eigen::VectorXd& value) override;
   void set_fej(const Eigen::VectorXd& fej) override;
+  void set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) override;
   std::shared_ptr<Type> clone_type() const override;
 
   const Eigen::Matrix3d& Rot() const { return R_; }
@@ -93,6 +100,7 @@ class PoseJPL : public Type {
   void update(const Eigen::VectorXd& dx) override;
   void set_value(const Eigen::VectorXd& value) override;
   void set_fej(const Eigen::VectorXd& fej) override;
+  void set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) override;
   std::shared_ptr<Type> clone_type() const override;
   bool contains(const Type* other) const override;
 
@@ -137,6 +145,7 @@ class ImuState : public Type {
   void update(const Eigen::VectorXd& dx) override;
   void set_value(const Eigen::VectorXd& value) override;
   void set_fej(const Eigen::VectorXd& fej) override;
+  void set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) override;
   std::shared_ptr<Type> clone_type() const override;
   bool contains(const Type* other) const override;
 

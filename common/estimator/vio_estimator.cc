@@ -250,6 +250,13 @@ void VioEstimator::initialize(const ImuValue& value, int64_t utime, const Matrix
   diverged_ = false;
 }
 
+void VioEstimator::restore(std::unique_ptr<State> state, FeatureDatabase tracks) {
+  state_ = std::move(state);
+  database_ = std::move(tracks);
+  initialized_ = true;
+  diverged_ = false;
+}
+
 void VioEstimator::reset() {
   state_ = std::make_unique<State>(options_.state);
   database_.clear();

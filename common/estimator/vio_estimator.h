@@ -140,6 +140,11 @@ class VioEstimator {
   /// An IMU reading older than every buffered one (a restored state's, see
   /// checkpoint.h); false if it is not older.
   bool prepend_imu(const ImuData& imu) { return propagator_.prepend(imu); }
+  /// Initialised with a whole state and its MSCKF tracks (a checkpoint's,
+  /// checkpoint.h); the extension, if any, takes its part afterwards.
+  void restore(std::unique_ptr<State> state, FeatureDatabase tracks);
+  /// The MSCKF feature tracks.
+  const FeatureDatabase& tracks() const { return database_; }
 
   /// Called once per divergence detection (covariance non-finite or with a
   /// negative diagonal, non-finite state, too large a correction, too high a

@@ -95,5 +95,35 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
   consistent_ = frames_since_violation_ >= options_.window && window_nis() <= options_.nis_max;
 }
 
+void AdaptiveNoise::save(estimator::CheckpointWriter* out) const {
+  out->put(sigma_);
+  out->put(static_cast<int64_t>(window_.size()));
+  for (const Frame& f : window_) out->put(f);
+  out->put(frame_chi2_);
+  out->put(frame_dof_);
+  out->put(frames_since_violation_);
+  out->put(consistent_);
+  out->put(violations_);
+  out->put(inflation_);
+}
+
+bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
+  AdaptiveNoise a = *this;
+  a.sigma_ = in->take<double>();
+  const int64_t n = in->take<int64_t>();
+  if (n < 0 || n > options_.window) return false;
+  a.window_.clear();
+  for (int64_t i = 0; i < n; ++i) a.window_.push_back(in->take<Frame>());
+  a.frame_chi2_ = in->take<double>();
+  a.frame_dof_ = in->take<int>();
+  a.frames_since_violation_ = in->take<int>();
+  a.consistent_ = in->take<bool>();
+  a.violations_ = in->take<int64_t>();
+  a.inflation_ = in->take<double>();
+  if (!in->ok() || !(a.sigma_ > 0.0)) return false;
+  *this = std::move(a);
+  return true;
+}
+
 }  // namespace target
 }  // namespace vimot

@@ -27,6 +27,8 @@
 #include <Eigen/Core>
 #include <deque>
 
+#include "common/estimator/checkpoint.h"
+
 namespace vimot {
 namespace target {
 
@@ -64,6 +66,11 @@ class AdaptiveNoise {
   /// Variance to add to each driven component after the last frame (0
   /// unless it violated the model).
   double inflation() const { return inflation_; }
+
+  /// Its whole memory into a checkpoint (target_checkpoint.h), and back
+  /// (false if the bytes are not one).
+  void save(estimator::CheckpointWriter* out) const;
+  bool load(estimator::CheckpointReader* in);
 
  private:
   struct Frame {

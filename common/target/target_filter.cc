@@ -85,6 +85,14 @@ void TargetState::set_value(const Eigen::VectorXd& value) {
   value_ << pose_->value(), v_->value(), w_->value();
 }
 
+void TargetState::set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) {
+  if (value.size() != 13 || fej.size() != 13) throw std::invalid_argument("TargetState::set_exact: expected 13");
+  pose_->set_exact(value.head<7>(), fej.head<7>());
+  v_->set_exact(value.segment<3>(7), fej.segment<3>(7));
+  w_->set_exact(value.segment<3>(10), fej.segment<3>(10));
+  Type::set_exact(value, fej);
+}
+
 void TargetState::set_fej(const Eigen::VectorXd& fej) {
   if (fej.size() != 13) throw std::invalid_argument("TargetState::set_fej: expected 13");
   pose_->set_fej(fej.head<7>());
@@ -169,6 +177,21 @@ void TargetFilter::reset() {
   predicted_.reset();
   if (adaptive_) {
     adaptive_.emplace(options_.adaptive, options_.sigma_t);
+    noise_ = options_.noise(adaptive_->sigma());
+  }
+}
+
+void TargetFilter::restore(std::shared_ptr<TargetState> target, std::map<int64_t, std::shared_ptr<PoseJPL>> clones,
+                           std::map<int64_t, TargetPoint> points, estimator::FeatureDatabase tracks, int64_t frame,
+                           std::optional<AdaptiveNoise> adaptive) {
+  reset();
+  target_ = std::move(target);
+  clones_ = std::move(clones);
+  points_ = std::move(points);
+  tracks_ = std::move(tracks);
+  frame_ = frame;
+  if (adaptive_ && adaptive) {
+    adaptive_ = std::move(adaptive);
     noise_ = options_.noise(adaptive_->sigma());
   }
 }

@@ -98,6 +98,7 @@ class TargetState : public estimator::Type {
   void update(const Eigen::VectorXd& dx) override;
   void set_value(const Eigen::VectorXd& value) override;
   void set_fej(const Eigen::VectorXd& fej) override;
+  void set_exact(const Eigen::VectorXd& value, const Eigen::VectorXd& fej) override;
   std::shared_ptr<estimator::Type> clone_type() const override;
   bool contains(const estimator::Type* other) const override;
 
@@ -244,6 +245,16 @@ class TargetFilter : public estimator::VioExtension {
   const std::map<int64_t, TargetPoint>& points() const { return points_; }
   /// The σ_t estimate and consistency check (kAdaptive only, else nullptr).
   const AdaptiveNoise* adaptive() const { return adaptive_ ? &*adaptive_ : nullptr; }
+  /// The bookkeeping a checkpoint needs beside the state's variables
+  /// (target_checkpoint.h): the frame count and the target feature tracks.
+  int64_t frame_count() const { return frame_; }
+  const estimator::FeatureDatabase& tracks() const { return tracks_; }
+  /// Takes over a checkpoint's target (nullptr: not initialised), its
+  /// clones and points (already in the estimator's state), tracks, frame
+  /// count and σ_t estimate (kAdaptive); what lives within a frame is cleared.
+  void restore(std::shared_ptr<TargetState> target, std::map<int64_t, std::shared_ptr<estimator::PoseJPL>> clones,
+               std::map<int64_t, TargetPoint> points, estimator::FeatureDatabase tracks, int64_t frame,
+               std::optional<AdaptiveNoise> adaptive);
   /// Whether target updates now change the robot (kEkf, or kAdaptive judged consistent).
   bool tightly_coupled() const;
 

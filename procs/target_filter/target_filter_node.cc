@@ -95,6 +95,8 @@ TargetFilterNode::TargetFilterNode(const TargetFilterNodeOptions& options, Callb
     target::TargetFilterOptions target = options_.target;
     target.init_perturb_seed = options_.perturb_seed;
     filter_ = std::make_unique<target::TargetFilter>(vins_.mutable_estimator(), target);
+    checkpoint_ = std::make_unique<target::TargetCheckpoint>(*filter_);
+    vins_.set_checkpoint_extension(checkpoint_.get());
   }
   vins_.set_frame_hooks([this](const CameraFrame& frame) { before_frame(frame); }, [this] { after_update(); });
 }

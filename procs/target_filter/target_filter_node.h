@@ -24,6 +24,7 @@
 
 #include "common/config/config.h"
 #include "common/estimator/vio_estimator.h"
+#include "common/target/target_checkpoint.h"
 #include "common/target/target_filter.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
@@ -52,7 +53,7 @@ struct TargetFilterNodeOptions {
   double ground_truth_buffer_s{2.0};
   /// Input guards (`input` section of the vins config), see VinsNodeOptions.
   InputGuardOptions input;
-  /// See VinsNodeOptions (the robot state only: the target is re-acquired).
+  /// See VinsNodeOptions; with the target filter's state (target_checkpoint.h).
   std::string checkpoint_path;
 };
 
@@ -102,6 +103,8 @@ class TargetFilterNode {
   const estimator::VioEstimator& estimator() const { return vins_.estimator(); }
   /// nullptr when target_enabled is false.
   const target::TargetFilter* filter() const { return filter_.get(); }
+  /// The filter's part of the checkpoint (nullptr without a filter).
+  const estimator::CheckpointExtension* checkpoint_extension() const { return checkpoint_.get(); }
 
  private:
   void before_frame(const CameraFrame& frame);
@@ -111,6 +114,7 @@ class TargetFilterNode {
   Callbacks callbacks_;
   VinsNode vins_;
   std::unique_ptr<target::TargetFilter> filter_;  // attached to vins_'s estimator
+  std::unique_ptr<target::TargetCheckpoint> checkpoint_;  // filter_'s part of vins_'s checkpoint
   std::map<int64_t, GroundTruth> truths_;  // by utime, for the target initialisation
 };
 

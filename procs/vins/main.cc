@@ -20,7 +20,7 @@ int run(int argc, const char* const* argv) {
   process.args().add_option("perturb-seed", "N",
                             "start from ground truth perturbed with this seed (overrides init.perturb_seed)");
   process.args().add_option("checkpoint", "PATH",
-                            "robot state file written per update; a restart goes on from it if recent (input.bridge_max_gap_s)");
+                            "estimator state file written per update; a restart goes on from it if recent (input.bridge_max_gap_s)");
   process.args().add_option("max-wait", "SECONDS",
                             "process a queued camera frame after this much wall time without IMU", "0.5");
   if (!process.init(argc, argv)) return 0;

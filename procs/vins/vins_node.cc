@@ -348,28 +348,31 @@ void VinsNode::initialise_from(const GroundTruth& truth) {
 void VinsNode::try_restore(int64_t input_utime) {
   if (restore_tried_ || options_.checkpoint_path.empty() || estimator_.initialized()) return;
   restore_tried_ = true;
-  estimator::RobotCheckpoint c;
+  estimator::EstimatorCheckpoint c;
   std::string why;
+  const std::string start = std::string("; starting ") + (options_.init_from_ground_truth ? "from ground truth" : "at rest");
   if (!estimator::read_checkpoint(options_.checkpoint_path, &c, &why)) {
     // None yet is a normal first start; an unreadable one is a fault.
     const bool absent = why.rfind("no checkpoint", 0) == 0;
-    say(absent ? NodeEvent::Kind::kInfo : NodeEvent::Kind::kError,
-        why + "; starting " + (options_.init_from_ground_truth ? "from ground truth" : "at rest"));
+    say(absent ? NodeEvent::Kind::kInfo : NodeEvent::Kind::kError, why + start);
     return;
   }
-  const double age_s = 1e-6 * static_cast<double>(input_utime - c.state.utime);
+  const double age_s = 1e-6 * static_cast<double>(input_utime - c.utime);
   if (!(age_s >= 0.0 && age_s <= options_.input.bridge_max_gap_s)) {
     std::ostringstream msg;
-    msg << "checkpoint " << options_.checkpoint_path << " rejected: stale, its utime " << c.state.utime << " is "
+    msg << "checkpoint " << options_.checkpoint_path << " rejected: stale, its utime " << c.utime << " is "
         << age_s << " s before the input (limit input.bridge_max_gap_s " << options_.input.bridge_max_gap_s
-        << " s); starting " << (options_.init_from_ground_truth ? "from ground truth" : "at rest");
+        << " s)" << start;
     say(NodeEvent::Kind::kInfo, msg.str());
     return;
   }
-  estimator::restore(c, &estimator_);
+  if (!estimator::restore(c, &estimator_, checkpoint_extension_, &why)) {
+    say(NodeEvent::Kind::kError, "checkpoint " + options_.checkpoint_path + " rejected: " + why + start);
+    return;
+  }
   restored_ = true;
   std::ostringstream msg;
-  msg << "restored from checkpoint " << options_.checkpoint_path << " at utime " << c.state.utime << ", " << age_s
+  msg << "restored from checkpoint " << options_.checkpoint_path << " at utime " << c.utime << ", " << age_s
       << " s before the input: bridging the gap";
   say(NodeEvent::Kind::kInfo, msg.str());
 }
@@ -377,7 +380,10 @@ void VinsNode::try_restore(int64_t input_utime) {
 void VinsNode::write_checkpoint() {
   if (options_.checkpoint_path.empty()) return;
   std::string why;
-  if (estimator::write_checkpoint(options_.checkpoint_path, estimator::checkpoint_of(estimator_), &why)) return;
+  if (estimator::write_checkpoint(options_.checkpoint_path,
+                                  estimator::checkpoint_of(estimator_, checkpoint_extension_), &why)) {
+    return;
+  }
   if (!std::exchange(checkpoint_failed_, true)) say(NodeEvent::Kind::kError, why + " (said once)");
 }
 

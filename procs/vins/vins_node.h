@@ -21,6 +21,7 @@
 #include <string>
 
 #include "common/config/config.h"
+#include "common/estimator/checkpoint.h"
 #include "common/estimator/vio_estimator.h"
 #include "common/process/node_event.h"
 #include "common/process/stream_guard.h"
@@ -102,10 +103,10 @@ struct VinsNodeOptions {
   /// anyway (IMU stream stalled) — bounded memory and latency.
   int max_queued_frames{5};
   InputGuardOptions input;
-  /// If set: the robot state is written there after every update
-  /// (common/estimator/checkpoint.h), and a start goes on from it when it
-  /// is at most input.bridge_max_gap_s older than the first input, bridging
-  /// the gap (a respawned process). Empty: no checkpoint.
+  /// If set: the estimator's whole state is written there after every
+  /// update (common/estimator/checkpoint.h), and a start goes on from it
+  /// when it is at most input.bridge_max_gap_s older than the first input,
+  /// bridging the gap (a respawned process). Empty: no checkpoint.
   std::string checkpoint_path;
 };
 
@@ -141,6 +142,8 @@ class VinsNode {
   /// frame: `before_frame` runs before the estimator sees a frame,
   /// `after_update` after a processed frame's updated state was published.
   void set_frame_hooks(std::function<void(const CameraFrame&)> before_frame, std::function<void()> after_update);
+  /// The attached extension's part of the checkpoint (not owned; set before any input).
+  void set_checkpoint_extension(estimator::CheckpointExtension* extension) { checkpoint_extension_ = extension; }
 
   bool initialized() const { return estimator_.initialized(); }
   int64_t frames_processed() const { return estimator_.frames_processed(); }
@@ -191,6 +194,7 @@ class VinsNode {
   EventCallback on_event_;
   std::function<void(const CameraFrame&)> before_frame_;
   std::function<void()> after_update_;
+  estimator::CheckpointExtension* checkpoint_extension_{nullptr};
   std::deque<CameraFrame> queued_frames_;
   int64_t last_frame_utime_{-1};
   int64_t resets_{0};
