@@ -139,7 +139,9 @@ TEST_CASE("StopAll while a killed shell's group is being stopped ends it as stop
   INFO(rec.AllEvents());
   CHECK(runner.state("stubborn").status == CommandStatus::kStopped);
   CHECK(runner.state("stubborn").start_count == 1);
-  CHECK(LiveGroupMembers(group) == 0);
+  // The stop ends when SIGKILL is sent; the kernel ends the members a moment
+  // later, so wait for that rather than read /proc in the same instant.
+  CHECK(PollUntil(&runner, [&] { return LiveGroupMembers(group) == 0; }));
 }
 
 namespace {
