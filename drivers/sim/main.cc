@@ -4,6 +4,7 @@
 // publishes rendered camera images (and the true target mask and box)
 // instead of FEATURES. The simulation and the rendering are common/sim (no
 // LCM); this file only converts and paces.
+#include <cmath>
 #include <variant>
 
 #include "common/process/event_sink.h"
@@ -42,6 +43,10 @@ int run(int argc, const char* const* argv) {
   process.args().add_option("duration", "SECONDS", "simulate only this long (overrides the config)");
   vimot::add_sink_options(process.args());
   vimot::add_clock_file_option(process.args());
+  process.args().add_option("outage-at", "SECONDS",
+                            "send nothing from this time of the run (s after its start) for --outage-length: "
+                            "the input outage of a driver killed and respawned then, reproducible in a log");
+  process.args().add_option("outage-length", "SECONDS", "with --outage-at: how long nothing is sent");
   process.args().add_flag("render", "publish rendered images, target masks and boxes instead of FEATURES");
   process.args().add_flag("with-features", "with --render, publish FEATURES too");
   if (!process.init(argc, argv)) return 0;
@@ -66,6 +71,23 @@ int run(int argc, const char* const* argv) {
   std::unique_ptr<vimot::sim::Renderer> renderer;
   if (render) renderer = std::make_unique<vimot::sim::Renderer>(sim);
 
+  // [outage_begin, outage_end): nothing sent (--outage-at, --outage-length).
+  int64_t outage_begin = 0;
+  int64_t outage_end = 0;
+  if (process.args().given("outage-at") != process.args().given("outage-length")) {
+    throw vimot::ArgError("vimot-sim: --outage-at and --outage-length go together");
+  }
+  if (process.args().given("outage-at")) {
+    const double at = process.args().get_double("outage-at");
+    const double length = process.args().get_double("outage-length");
+    if (!(at >= 0.0 && at <= sim.duration()) || !(length > 0.0 && length <= sim.duration())) {
+      throw vimot::ArgError("vimot-sim: the outage must start within the run (0 to " +
+                            std::to_string(sim.duration()) + " s) and last a positive time no longer than it");
+    }
+    outage_begin = sim.start_utime() + static_cast<int64_t>(std::llround(at * 1e6));
+    outage_end = outage_begin + static_cast<int64_t>(std::llround(length * 1e6));
+  }
+
   int64_t resume_utime = sim.start_utime();
   const std::unique_ptr<vimot::EventSink> sink =
       vimot::make_sink(process, sim.start_utime(), sim.duration(), &resume_utime);
@@ -80,7 +102,9 @@ int run(int argc, const char* const* argv) {
     const std::optional<vimot::sim::SimEvent> event = sim.next();
     if (!event) break;
     // Restarted mid-run (--clock-file): what fell due meanwhile was never sent.
-    if (std::visit([](const auto& e) { return e.utime; }, *event) < resume_utime) continue;
+    const int64_t event_utime = std::visit([](const auto& e) { return e.utime; }, *event);
+    if (event_utime < resume_utime) continue;
+    if (event_utime >= outage_begin && event_utime < outage_end) continue;
     int64_t utime = 0;
     if (const auto* imu = std::get_if<vimot::ImuData>(&*event)) {
       vimot::emit(*sink, imu_channel, vimot::to_lcm(*imu));

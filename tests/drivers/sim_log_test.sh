@@ -18,4 +18,20 @@ grep -Eq '^GROUND_TRUTH +vimot.ground_truth_t +2001 ' "$work/summary.txt" || { e
 grep -Eq '^FEATURES +vimot.features_t +101 ' "$work/summary.txt" || { echo "FAIL: expected 101 FEATURES"; exit 1; }
 # Event time = utime: a log "recorded at" real time, which scripts/replay.sh relies on.
 [ "$("$summary" --speed "$work/a.lcm")" = 1 ] || { echo "FAIL: vimot-sim --log must read as recorded at 1x"; exit 1; }
+# --outage-at 5 --outage-length 1: nothing with utime in [5 s, 6 s) after the
+# start, hand count: 200 IMU samples and truths, 10 frames fewer, and one
+# silence of 1.005 s (IMU) / 1.1 s (frames) in each stream.
+"$sim" --config "$config" --seed 3 --duration 10 --outage-at 5 --outage-length 1 --log "$work/d.lcm" --log-level warn
+"$summary" --gaps "$work/d.lcm" > "$work/outage.txt"
+cat "$work/outage.txt"
+grep -Eq '^IMU +vimot.imu_t +1801 .* 1\.005 ' "$work/outage.txt" || { echo "FAIL: outage: expected 1801 IMU, gap 1.005 s"; exit 1; }
+grep -Eq '^GROUND_TRUTH +vimot.ground_truth_t +1801 ' "$work/outage.txt" || { echo "FAIL: outage: expected 1801 GROUND_TRUTH"; exit 1; }
+grep -Eq '^FEATURES +vimot.features_t +91 .* 1\.100 ' "$work/outage.txt" || { echo "FAIL: outage: expected 91 FEATURES, gap 1.1 s"; exit 1; }
+for bad in "--outage-at 5" "--outage-at 5 --outage-length 0" "--outage-at -1 --outage-length 1" "--outage-at 11 --outage-length 1"; do
+  # shellcheck disable=SC2086
+  if "$sim" --config "$config" --duration 10 $bad --log "$work/e.lcm" --log-level warn 2> "$work/err.txt"; then
+    echo "FAIL: vimot-sim accepted $bad"; exit 1
+  fi
+  grep -q "outage" "$work/err.txt" || { cat "$work/err.txt"; echo "FAIL: no clear error for $bad"; exit 1; }
+done
 echo "PASS"
