@@ -19,6 +19,9 @@
 #               relative to the robot, in one target frame for the run) of
 #               VINS_STATE, NAV_STATE and TARGET_STATE at most 10 % above the
 #               undisturbed run's.
+#   replay      every output equals the offline replay of the run's logged
+#               inputs through the same Nodes (vimot-log-replay): the live
+#               run did what the estimators do offline on that input.
 # Exits 0 if every check passed, 1 if one failed, 2 on a setup error.
 #
 # Usage: scripts/kill_recovery.sh [--deputy] [--victims "vins target_filter sim"]
@@ -54,7 +57,7 @@ for v in $victims; do
     *) echo "kill_recovery.sh: cannot check '$v' (vins, target_filter or sim; see docs/sheriff.md)" >&2; exit 2 ;;
   esac
 done
-for exe in vimot-sheriff vimot-deputy vimot-sim vimot-vins vimot-target-filter vimot-log-summary vimot-log-eval; do
+for exe in vimot-sheriff vimot-deputy vimot-sim vimot-vins vimot-target-filter vimot-log-summary vimot-log-eval vimot-log-replay; do
   [ -x "$bin/$exe" ] || { echo "kill_recovery.sh: $bin/$exe not built (scripts/build.sh)" >&2; exit 2; }
 done
 
@@ -144,6 +147,13 @@ run() {
   "$bin/vimot-log-summary" --gaps "$VIMOT_LOG" > "$dir/summary.txt" || true
   # One target frame for the whole run: every victim's restart keeps the target.
   evaluate "$dir" "$VIMOT_LOG"
+  # The same inputs through the same Nodes offline: the live outputs must be
+  # these, bit for bit (after a simulator kill: what scripts/outage_sweep.sh
+  # measures for an outage of that length over seeds).
+  local rc=0
+  "$bin/vimot-log-replay" --vins "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --target-filter "$VIMOT_CONFIG/target_filter.yaml" \
+    "$VIMOT_LOG" > "$dir/replay.txt" 2>&1 || rc=$?
+  echo "$rc" > "$dir/replay.rc"
 }
 
 # evaluate DIR LOG: vimot-log-eval of VINS_STATE and of NAV_STATE + TARGET_STATE.
@@ -192,6 +202,8 @@ for ch in VINS_STATE NAV_STATE TARGET_STATE; do
 done
 echo "   TARGET_STATE target in the IMU frame: position RMSE $(metric TARGET_IN_IMU "$out/undisturbed") m"
 echo "   IMU/FEATURES messages lost under load:$(losses "$out/undisturbed")"
+check "every output equals its offline replay (vimot-log-replay, $out/undisturbed/replay.txt)" \
+  [ "$(cat "$out/undisturbed/replay.rc")" = 0 ]
 # said FILE PROCESS TEXT: PROCESS logged a line with TEXT.
 said() { grep -qE "^\[([^]]*:)?$2\] .*$3" "$1"; }
 # ratio CHANNEL DIR_A DIR_B: "a m <= 1.1 x b m" check of metric CHANNEL.
@@ -233,6 +245,7 @@ for victim in $victims; do
   for p in vins target_filter; do
     check "$p did not reset" eval "! said '$d/sheriff.txt' $p 'reset, re-initialising'"
   done
+  check "every output equals its offline replay (vimot-log-replay, $d/replay.txt)" [ "$(cat "$d/replay.rc")" = 0 ]
   echo "   accuracy over the whole run against the undisturbed run:"
   for ch in VINS_STATE NAV_STATE TARGET_STATE TARGET_IN_IMU; do ratio $ch "$d" "$out/undisturbed"; done
 done
