@@ -127,6 +127,9 @@ export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0&recv_
 out="${VIMOT_OUT:-$here/out/demo-$(date +%Y%m%d-%H%M%S)}"
 mkdir -p "$out"
 export VIMOT_LOG="$out/demo.lcmlog"
+# sim_demo.pmd's logger appends (so a respawned one keeps the record): start
+# each run with no log.
+rm -f "$VIMOT_LOG"
 # The estimators' checkpoints (sim_demo.pmd), rewritten after every update:
 # on a RAM file system, off the disk the log is written to; removed at the end.
 export VIMOT_CKPT="/dev/shm/vimot-demo-$$"

@@ -1,6 +1,7 @@
 #include "common/process/event_sink.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -15,13 +16,64 @@ std::chrono::steady_clock::duration seconds(double s) {
 
 }  // namespace
 
-LogFileSink::LogFileSink(const std::string& path) : log_(path, "w") {
+LogFileTail scan_log_file(const std::string& path) {
+  LogFileTail tail;
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) return tail;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read '" + path + "'");
+  tail.file_bytes = static_cast<int64_t>(std::filesystem::file_size(path));
+  // An event: marker, event number, timestamp, channel length, data length
+  // (big-endian), then the channel and the data.
+  constexpr uint32_t kMarker = 0xEDA1DA01;
+  constexpr int64_t kHeaderBytes = 4 + 8 + 8 + 4 + 4;
+  const auto be32 = [](const unsigned char* b) {
+    return (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | uint32_t{b[3]};
+  };
+  int64_t pos = 0;
+  unsigned char header[kHeaderBytes];
+  while (pos + kHeaderBytes <= tail.file_bytes) {
+    in.seekg(pos);
+    if (!in.read(reinterpret_cast<char*>(header), kHeaderBytes)) break;
+    const int64_t channel_bytes = static_cast<int32_t>(be32(header + 20));
+    const int64_t data_bytes = static_cast<int32_t>(be32(header + 24));
+    if (be32(header) != kMarker || channel_bytes <= 0 || data_bytes < 0) {
+      ++pos;  // not an event here: look for the next marker
+      continue;
+    }
+    const int64_t end = pos + kHeaderBytes + channel_bytes + data_bytes;
+    if (end > tail.file_bytes) break;  // cut short by the end of the file
+    ++tail.events;
+    tail.complete_bytes = end;
+    pos = end;
+  }
+  return tail;
+}
+
+namespace {
+
+// Cuts a half-written last event; returns what was found.
+LogFileTail prepare_append(const std::string& path) {
+  const LogFileTail tail = scan_log_file(path);
+  if (tail.complete_bytes < tail.file_bytes) {
+    std::error_code error;
+    std::filesystem::resize_file(path, static_cast<std::uintmax_t>(tail.complete_bytes), error);
+    if (error) throw std::runtime_error("cannot cut the half-written end of '" + path + "': " + error.message());
+  }
+  return tail;
+}
+
+}  // namespace
+
+LogFileSink::LogFileSink(const std::string& path, Mode mode)
+    : found_(mode == Mode::kAppend ? prepare_append(path) : LogFileTail{}),
+      log_(path, mode == Mode::kAppend ? "a" : "w") {
   if (!log_.good()) throw std::runtime_error("cannot open '" + path + "' for writing");
 }
 
 void LogFileSink::write(const std::string& channel, int64_t utime, const void* data, int size) {
   lcm::LogEvent ev;
-  ev.eventnum = eventnum_++;
+  ev.eventnum = 0;  // LCM's writer numbers the events itself
   ev.timestamp = utime;  // message time, not wall time: same input, same bytes
   ev.channel = channel;
   ev.datalen = size;

@@ -23,15 +23,37 @@ class EventSink {
   virtual void write(const std::string& channel, int64_t utime, const void* data, int size) = 0;
 };
 
+/// What an LCM log file holds up to its last whole event.
+struct LogFileTail {
+  int64_t events{0};          // whole events
+  int64_t complete_bytes{0};  // where the last whole event ends
+  int64_t file_bytes{0};      // the file's size: more = a half-written event
+};
+
+/// Scans the LCM log at `path` event by event (headers only, so a log of
+/// any size), resynchronising on the event marker as LCM's reader does.
+/// A missing file is an empty one. Throws std::runtime_error if it cannot
+/// be read.
+LogFileTail scan_log_file(const std::string& path);
+
 class LogFileSink : public EventSink {
  public:
+  enum class Mode {
+    kReplace,
+    /// Go on with an existing log (a respawned logger): a half-written last
+    /// event (its writer killed) is cut first, so the next event starts
+    /// where a reader expects one (LCM numbers the new events from 0).
+    kAppend,
+  };
   /// Throws std::runtime_error if `path` cannot be opened for writing.
-  explicit LogFileSink(const std::string& path);
+  explicit LogFileSink(const std::string& path, Mode mode = Mode::kReplace);
   void write(const std::string& channel, int64_t utime, const void* data, int size) override;
+  /// With kAppend: the log as found (before a half-written event was cut).
+  const LogFileTail& found() const { return found_; }
 
  private:
+  LogFileTail found_;
   lcm::LogFile log_;
-  int64_t eventnum_{0};
 };
 
 /// Publishes through the process's LCM handle; with speed > 0 a message of

@@ -17,7 +17,10 @@ int main(int argc, char** argv) {
                            "per channel what it logged in its heartbeat and \"stopping:\" line. Stop it with\n"
                            "SIGINT or SIGTERM; with --drain it first logs until the network has been quiet for\n"
                            "--drain-quiet seconds.");
-    process.args().add_option("log", "FILE", "LCM log file to write (replaced if it exists; required)");
+    process.args().add_option("log", "FILE", "LCM log file to write (replaced if it exists, unless --append; required)");
+    process.args().add_flag("append",
+                            "go on with FILE if it exists (a respawned logger keeps the run's record; a "
+                            "half-written last event, its writer killed, is cut first)");
     process.args().add_option("channels", "REGEX", "channels to log (LCM regex, the whole name)", ".*");
     process.args().add_option("exclude", "REGEX",
                               "channels not to log, of those --channels selects (POSIX extended regex, the whole "
@@ -32,7 +35,18 @@ int main(int argc, char** argv) {
     if (queue < 1 || queue > 100000000) {
       throw vimot::ArgError("vimot-logger: --queue must be 1 to 1e8 messages, got " + process.args().get("queue"));
     }
-    vimot::LogFileSink sink(process.args().get("log"));
+    const std::string path = process.args().get("log");
+    const bool append = process.args().given("append");
+    vimot::LogFileSink sink(path, append ? vimot::LogFileSink::Mode::kAppend : vimot::LogFileSink::Mode::kReplace);
+    if (append && sink.found().file_bytes > 0) {
+      const vimot::LogFileTail& found = sink.found();
+      vimot::log_warn("appending to ", path, " (", found.events, " events already there",
+                      found.complete_bytes < found.file_bytes
+                          ? ", a half-written last event of " + std::to_string(found.file_bytes - found.complete_bytes) +
+                                " bytes cut"
+                          : std::string(),
+                      "); what was published while no logger ran is not in it");
+    }
     process.subscribe_raw(
         process.args().get("channels"),
         [&sink](const std::string& channel, int64_t recv_utime, const void* data, int size) {
@@ -40,8 +54,7 @@ int main(int argc, char** argv) {
         },
         static_cast<int>(queue), process.args().get("exclude"));
     const std::string exclude = process.args().get("exclude");
-    vimot::log_info("logging ", process.args().get("channels"), exclude.empty() ? "" : " but " + exclude, " to ",
-                    process.args().get("log"));
+    vimot::log_info("logging ", process.args().get("channels"), exclude.empty() ? "" : " but " + exclude, " to ", path);
     return process.run();
   });
 }
