@@ -118,8 +118,13 @@ int run(int argc, const char* const* argv) {
               << std::setw(10) << std::fixed << std::setprecision(1) << rate << std::setw(12) << s.bytes / 1024
               << std::setw(12) << s.undecodable;
     if (gaps) {
-      std::cout << std::setw(12) << std::setprecision(3) << vimot::utime_to_seconds(s.max_gap) << std::setw(10)
-                << std::setprecision(1) << vimot::utime_to_seconds(s.max_gap_end - log_start);
+      std::cout << std::setw(12) << std::setprecision(3) << vimot::utime_to_seconds(s.max_gap) << std::setw(10);
+      // One message has no gap to have ended.
+      if (s.count > 1) {
+        std::cout << std::setprecision(1) << vimot::utime_to_seconds(s.max_gap_end - log_start);
+      } else {
+        std::cout << "-";
+      }
     }
     std::cout << "\n";
   }
