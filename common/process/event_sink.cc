@@ -1,6 +1,7 @@
 #include "common/process/event_sink.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <thread>
 
@@ -15,7 +16,7 @@ std::chrono::steady_clock::duration seconds(double s) {
 
 }  // namespace
 
-LogFileSink::LogFileSink(const std::string& path) : log_(path, "w") {
+LogFileSink::LogFileSink(const std::string& path, bool flush_each) : log_(path, "w"), flush_each_(flush_each) {
   if (!log_.good()) throw std::runtime_error("cannot open '" + path + "' for writing");
 }
 
@@ -26,7 +27,9 @@ void LogFileSink::write(const std::string& channel, int64_t utime, const void* d
   ev.channel = channel;
   ev.datalen = size;
   ev.data = const_cast<void*>(data);
-  if (log_.writeEvent(&ev) != 0) throw std::runtime_error("writing the log failed (disk full?)");
+  if (log_.writeEvent(&ev) != 0 || (flush_each_ && std::fflush(log_.getFilePtr()) != 0)) {
+    throw std::runtime_error("writing the log failed (disk full?)");
+  }
 }
 
 LcmSink::LcmSink(Process& process, double speed, int64_t first_utime, double start_delay_s)

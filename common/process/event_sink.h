@@ -26,11 +26,15 @@ class EventSink {
 class LogFileSink : public EventSink {
  public:
   /// Throws std::runtime_error if `path` cannot be opened for writing.
-  explicit LogFileSink(const std::string& path);
+  /// `flush_each`: every event is in the file when write() returns, so a
+  /// respawned estimator can read what it missed (--catch-up-log) while the
+  /// run goes on (vimot-logger); off, a driver's offline --log writes fast.
+  explicit LogFileSink(const std::string& path, bool flush_each = false);
   void write(const std::string& channel, int64_t utime, const void* data, int size) override;
 
  private:
   lcm::LogFile log_;
+  bool flush_each_;
   int64_t eventnum_{0};
 };
 
