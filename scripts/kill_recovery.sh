@@ -12,7 +12,8 @@
 #   kept        the estimate survived: a killed vins or target_filter
 #               restored its whole state (the target filter's with its
 #               target) from its checkpoint (--checkpoint in sim_demo.pmd,
-#               under /dev/shm), after a simulator kill both estimators
+#               under /dev/shm) and caught up on the input it missed from
+#               the run's log (--catch-up-log), after a simulator kill both estimators
 #               bridged the outage; neither reset;
 #   accuracy    position RMSE (vimot-log-eval: every updated state of the
 #               run against the ground truth; the target in the world and
@@ -241,6 +242,7 @@ for victim in $victims; do
     for p in vins target_filter; do check "$p bridged the outage" said "$d/sheriff.txt" $p "bridged, the estimate kept"; done
   else
     check "$victim restored its checkpoint" said "$d/sheriff.txt" "$victim" "restored from checkpoint"
+    check "$victim caught up from the log" said "$d/sheriff.txt" "$victim" "caught up "
   fi
   for p in vins target_filter; do
     check "$p did not reset" eval "! said '$d/sheriff.txt' $p 'reset, re-initialising'"
