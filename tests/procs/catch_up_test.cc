@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <unistd.h>
 #include <variant>
 #include <vector>
 
@@ -91,22 +90,6 @@ struct Outputs {
     return cb;
   }
 };
-
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() : path(std::filesystem::temp_directory_path() / ("vimot_catch_up_test_" + std::to_string(::getpid()))) {
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
-
-template <typename Node>
-void feed_one(Node& node, const sim::SimEvent& e) {
-  if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
-  if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
-  if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
-}
 
 // The logger's file: the events in order, except those with utime in [gap_from, gap_to).
 void write_log(const std::string& path, const std::vector<sim::SimEvent>& events, int64_t gap_from = INT64_MAX,
