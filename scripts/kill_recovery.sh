@@ -13,9 +13,10 @@
 #   kept        the estimate survived: a killed vins or target_filter
 #               restored its whole state (the target filter's with its
 #               target) from its checkpoint (--checkpoint in sim_demo.pmd,
-#               under /dev/shm), after a simulator kill both estimators
-#               bridged the outage, a killed logger appended to the run's
-#               log; neither estimator reset;
+#               under /dev/shm) and caught up on the input it missed from
+#               the run's log (--catch-up-log), after a simulator kill both
+#               estimators bridged the outage, a killed logger appended to
+#               the run's log; neither estimator reset;
 #   accuracy    position RMSE (vimot-log-eval: every updated state of the
 #               run against the ground truth; the target in the world and
 #               relative to the robot, in one target frame for the run) of
@@ -248,6 +249,7 @@ for victim in $victims; do
     check "the logger appended to the run's log" said "$d/sheriff.txt" logger "appending to"
   else
     check "$victim restored its checkpoint" said "$d/sheriff.txt" "$victim" "restored from checkpoint"
+    check "$victim caught up from the log" said "$d/sheriff.txt" "$victim" "caught up "
   fi
   for p in vins target_filter; do
     check "$p did not reset" eval "! said '$d/sheriff.txt' $p 'reset, re-initialising'"

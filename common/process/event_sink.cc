@@ -1,6 +1,7 @@
 #include "common/process/event_sink.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -65,9 +66,10 @@ LogFileTail prepare_append(const std::string& path) {
 
 }  // namespace
 
-LogFileSink::LogFileSink(const std::string& path, Mode mode)
+LogFileSink::LogFileSink(const std::string& path, Mode mode, bool flush_each)
     : found_(mode == Mode::kAppend ? prepare_append(path) : LogFileTail{}),
-      log_(path, mode == Mode::kAppend ? "a" : "w") {
+      log_(path, mode == Mode::kAppend ? "a" : "w"),
+      flush_each_(flush_each) {
   if (!log_.good()) throw std::runtime_error("cannot open '" + path + "' for writing");
 }
 
@@ -78,7 +80,9 @@ void LogFileSink::write(const std::string& channel, int64_t utime, const void* d
   ev.channel = channel;
   ev.datalen = size;
   ev.data = const_cast<void*>(data);
-  if (log_.writeEvent(&ev) != 0) throw std::runtime_error("writing the log failed (disk full?)");
+  if (log_.writeEvent(&ev) != 0 || (flush_each_ && std::fflush(log_.getFilePtr()) != 0)) {
+    throw std::runtime_error("writing the log failed (disk full?)");
+  }
 }
 
 LcmSink::LcmSink(Process& process, double speed, int64_t first_utime, double start_delay_s)

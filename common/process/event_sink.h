@@ -46,7 +46,10 @@ class LogFileSink : public EventSink {
     kAppend,
   };
   /// Throws std::runtime_error if `path` cannot be opened for writing.
-  explicit LogFileSink(const std::string& path, Mode mode = Mode::kReplace);
+  /// `flush_each`: every event is in the file when write() returns, so a
+  /// respawned estimator can read what it missed (--catch-up-log) while the
+  /// run goes on (vimot-logger); off, a driver's offline --log writes fast.
+  explicit LogFileSink(const std::string& path, Mode mode = Mode::kReplace, bool flush_each = false);
   void write(const std::string& channel, int64_t utime, const void* data, int size) override;
   /// With kAppend: the log as found (before a half-written event was cut).
   const LogFileTail& found() const { return found_; }
@@ -54,6 +57,7 @@ class LogFileSink : public EventSink {
  private:
   LogFileTail found_;
   lcm::LogFile log_;
+  bool flush_each_;
 };
 
 /// Publishes through the process's LCM handle; with speed > 0 a message of

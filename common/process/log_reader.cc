@@ -73,14 +73,28 @@ void LogReader::on_target_box(const std::string& channel, std::function<void(con
   subscribe<target_box_t>(channel, std::move(use), malformed);
 }
 
+void LogReader::on_imu(const std::string& channel, std::function<void(const ImuData&)> use, int64_t* malformed) {
+  subscribe<imu_t>(channel, std::move(use), malformed);
+}
+
+void LogReader::on_features(const std::string& channel, std::function<void(const CameraFrame&)> use,
+                            int64_t* malformed) {
+  subscribe<features_t>(channel, std::move(use), malformed);
+}
+
 int64_t LogReader::read_all() {
   int64_t events = 0;
-  while (const lcm::LogEvent* ev = log_->file.readNextEvent()) {
-    ++events;
-    const auto it = handlers_.find(ev->channel);
-    if (it != handlers_.end()) it->second(ev->data, ev->datalen, ev->eventnum, ev->channel);
-  }
+  while (read_next()) ++events;
   return events;
+}
+
+bool LogReader::read_next() {
+  // LCM's reader returns null on a short read: a partial event ends the log.
+  const lcm::LogEvent* ev = log_->file.readNextEvent();
+  if (ev == nullptr) return false;
+  const auto it = handlers_.find(ev->channel);
+  if (it != handlers_.end()) it->second(ev->data, ev->datalen, ev->eventnum, ev->channel);
+  return true;
 }
 
 }  // namespace vimot

@@ -14,6 +14,7 @@
 #include "common/object/scale_estimator.h"
 #include "common/types/ground_truth.h"
 #include "common/types/nav_state.h"
+#include "common/types/sensor_data.h"
 #include "common/types/target_box.h"
 #include "common/types/target_state.h"
 
@@ -44,9 +45,15 @@ class LogReader {
 
   void on_target_box(const std::string& channel, std::function<void(const CameraTargetBox&)> use,
                      int64_t* malformed);
+  void on_imu(const std::string& channel, std::function<void(const ImuData&)> use, int64_t* malformed);
+  void on_features(const std::string& channel, std::function<void(const CameraFrame&)> use, int64_t* malformed);
 
   /// Reads every event in order; returns how many there were.
   int64_t read_all();
+  /// Reads the next event and hands it to its channel's handler; false at
+  /// the end of the log. A partial last event (its writer is mid-write) is
+  /// the end.
+  bool read_next();
   /// "event <n> on <channel>: <why>" of the first malformed message, or empty.
   const std::string& first_malformed() const { return first_malformed_; }
 

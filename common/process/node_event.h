@@ -10,11 +10,13 @@ namespace vimot {
 
 struct NodeEvent {
   /// kLost: `count` messages of a stream never arrived (utime gap);
-  /// kError: also a reset of the estimate (the heartbeat says degraded).
-  enum class Kind { kInfo, kDropped, kError, kLost } kind{Kind::kInfo};
+  /// kError: also a reset of the estimate (the heartbeat says degraded);
+  /// kCaughtUp: `count` messages of a stream a respawned node missed were
+  /// handled from the run's log (--catch-up-log).
+  enum class Kind { kInfo, kDropped, kError, kLost, kCaughtUp } kind{Kind::kInfo};
   std::string message;
   int64_t count{1};
-  std::string stream{};  // kLost: which input stream (IMU, FEATURES, GROUND_TRUTH)
+  std::string stream{};  // kLost, kCaughtUp: which input stream (IMU, FEATURES, GROUND_TRUTH)
 };
 
 /// The input streams of an estimator node (run_estimator_node).

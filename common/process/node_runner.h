@@ -6,6 +6,9 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
+#include <memory>
+#include <string>
 
 #include "common/process/lcm_conversions.h"
 #include "common/process/node_event.h"
@@ -16,16 +19,42 @@
 
 namespace vimot {
 
-/// Info is logged; dropped input and errors are counted in the heartbeat.
+/// Info is logged; dropped input and errors are counted in the heartbeat,
+/// and input handled from the catch-up log as "caught up <stream>".
 inline std::function<void(const NodeEvent&)> report_events_to(Process& process) {
-  return [&process](const NodeEvent& e) {
+  auto caught_up = std::make_shared<std::map<std::string, int64_t>>();
+  return [&process, caught_up](const NodeEvent& e) {
     switch (e.kind) {
       case NodeEvent::Kind::kInfo: log_info(e.message); break;
       case NodeEvent::Kind::kDropped: process.report_dropped(e.message); break;
       case NodeEvent::Kind::kError: process.report_error(e.message); break;
       case NodeEvent::Kind::kLost: process.report_lost(e.count, e.message, e.stream); break;
+      case NodeEvent::Kind::kCaughtUp:
+        process.set_counter("caught up " + e.stream, (*caught_up)[e.stream] += e.count);
+        break;
     }
   };
+}
+
+/// --catch-up-log FILE (with --checkpoint): a respawned estimator handles the
+/// input it missed from the run's LCM log before the live input.
+inline void add_catch_up_option(ArgParser& args) {
+  args.add_option("catch-up-log", "FILE",
+                  "with --checkpoint: after a restore, first handle the input missed while down from this LCM log\n"
+                  "(vimot-logger's), so the estimate goes on as if never stopped; bridged where the log lacks it");
+}
+
+/// The catch-up log and the input channels (the process's channel names) for `options`.
+template <typename NodeOptions>
+void set_catch_up(Process& process, NodeOptions* options, bool use_ground_truth) {
+  if (!process.args().given("catch-up-log")) return;
+  if (!process.args().given("checkpoint")) {
+    throw ArgError(process.name() + ": --catch-up-log needs --checkpoint (it goes on from the restored state)");
+  }
+  options->catch_up_log = process.args().get("catch-up-log");
+  options->catch_up_channels.imu = process.channel("imu", "IMU");
+  options->catch_up_channels.features = process.channel("features", "FEATURES");
+  options->catch_up_channels.ground_truth = use_ground_truth ? process.channel("ground_truth", "GROUND_TRUTH") : "";
 }
 
 /// Subscribes IMU, FEATURES and (if `use_ground_truth`) GROUND_TRUTH to the

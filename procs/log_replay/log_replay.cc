@@ -200,21 +200,35 @@ ReplayReport replay_log(const std::string& log_path, const ReplaySetup& setup) {
     c.recorded = static_cast<int64_t>(live.size());
     c.replayed = static_cast<int64_t>(replayed.size());
     // In order; a replayed message the log lacks (lcm-logger lost it under
-    // load) is passed over when the recorded one follows within a few.
+    // load) is passed over when the recorded one follows within a few. A
+    // process respawned from its checkpoint publishes again what it had
+    // published after it: a recorded message equal to one matched shortly
+    // before is such a copy, and the order goes on from there.
     constexpr std::size_t kLookahead = 50;
     std::size_t j = 0;
+    std::size_t matched = 0;  // replayed messages before this one were matched once
     for (std::size_t i = 0; i < live.size(); ++i) {
       std::size_t k = j;
       while (k < replayed.size() && k < j + kLookahead && replayed[k] != live[i]) ++k;
       if (k == replayed.size() || k == j + kLookahead) {
-        c.first_difference = static_cast<int64_t>(i);
-        break;
+        k = j;
+        while (k > 0 && k + kLookahead > j && replayed[k - 1] != live[i]) --k;
+        if (k == 0 || k + kLookahead == j) {
+          c.first_difference = static_cast<int64_t>(i);
+          break;
+        }
+        --k;
       }
-      c.not_logged += static_cast<int64_t>(k - j);
-      ++c.identical;
+      if (k < matched) {
+        ++c.republished;
+      } else {
+        c.not_logged += static_cast<int64_t>(k - std::max(j, matched));
+        ++c.identical;
+      }
       j = k + 1;
+      matched = std::max(matched, j);
     }
-    if (c.first_difference < 0) c.not_logged += static_cast<int64_t>(replayed.size() - j);
+    if (c.first_difference < 0) c.not_logged += static_cast<int64_t>(replayed.size() - matched);
     if (c.first_difference >= 0 && static_cast<std::size_t>(c.first_difference) < live.size()) {
       const Bytes& m = live[static_cast<std::size_t>(c.first_difference)];
       c.first_difference_utime = vimot_message_utime(m.data(), static_cast<int>(m.size()));

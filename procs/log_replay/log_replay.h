@@ -7,10 +7,12 @@
 // the outputs the live processes logged. The Nodes order their inputs by
 // utime (procs/vins/vins_node.h), so the logger's interleaving of the
 // channels does not change the result: an undisturbed live run is
-// reproduced bit for bit. Not reproducible: a run in which the live process
-// lost or skipped input the logger got (counted in its heartbeats), was
-// restarted mid-run, or flushed a frame because the IMU stalled for its
-// --max-wait of wall time.
+// reproduced bit for bit, and so is one whose process was respawned and
+// caught up from the log (--catch-up-log; what it published again is
+// counted as republished). Not reproducible: a run in which the live
+// process lost or skipped input the logger got (counted in its heartbeats),
+// was restarted without catch-up, or flushed a frame because the IMU
+// stalled for its --max-wait of wall time.
 
 #include <cstdint>
 #include <string>
@@ -46,6 +48,10 @@ struct ChannelComparison {
   /// Replayed messages the log lacks between (or after) identical ones: the
   /// live process published them, the logger did not get them (UDP).
   int64_t not_logged{0};
+  /// Recorded messages equal byte for byte to a replayed one already
+  /// matched: published again by a process respawned from its checkpoint
+  /// (it had published them after the checkpoint before it died).
+  int64_t republished{0};
   /// Index of the first recorded message not reproduced, -1 if every one was.
   int64_t first_difference{-1};
   /// utime of the recorded message there (-1 if the recording ended first).

@@ -18,8 +18,10 @@ int run(int argc, const char* const* argv) {
                         "processes, in log order, in one thread, as fast as the CPU allows, and compares\n"
                         "each output (VINS_STATE; NAV_STATE, TARGET_STATE, TARGET_PREDICTION) byte for byte\n"
                         "with the messages the live processes logged, in order (a replayed message the log\n"
-                        "lacks, lost by the logger, is counted as not logged). An undisturbed live run is\n"
-                        "reproduced bit for bit (docs/record_replay.md).\n"
+                        "lacks, lost by the logger, is counted as not logged; a copy a respawned process\n"
+                        "published again after catching up, as republished). An undisturbed live run, and one\n"
+                        "with processes respawned with --catch-up-log, is reproduced bit for bit\n"
+                        "(docs/record_replay.md).\n"
                         "Exit status: 0 all outputs identical; 3 a difference (first one printed); 2 nothing\n"
                         "to compare (no recorded outputs); 1 bad input.");
   args.set_positional("LOG", "LCM log of a live run (lcm-logger, scripts/record.sh, scripts/demo.sh)", 1, 1);
@@ -60,12 +62,14 @@ int run(int argc, const char* const* argv) {
   if (report.cpu_s > 0) std::cout << " (" << std::setprecision(1) << report.data_span_s / report.cpu_s << "x real time)";
   std::cout << "\n";
   std::cout << std::left << std::setw(22) << "channel" << std::right << std::setw(10) << "recorded" << std::setw(10)
-            << "replayed" << std::setw(11) << "identical" << std::setw(12) << "not logged" << "  first difference\n";
+            << "replayed" << std::setw(11) << "identical" << std::setw(12) << "not logged" << std::setw(13) << "republished"
+            << "  first difference\n";
   int64_t recorded = 0;
   for (const vimot::ChannelComparison& c : report.channels) {
     recorded += c.recorded;
     std::cout << std::left << std::setw(22) << c.channel << std::right << std::setw(10) << c.recorded << std::setw(10)
-              << c.replayed << std::setw(11) << c.identical << std::setw(12) << c.not_logged << "  ";
+              << c.replayed << std::setw(11) << c.identical << std::setw(12) << c.not_logged << std::setw(13)
+              << c.republished << "  ";
     if (c.equal()) {
       std::cout << "none\n";
     } else {

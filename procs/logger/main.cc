@@ -37,7 +37,10 @@ int main(int argc, char** argv) {
     }
     const std::string path = process.args().get("log");
     const bool append = process.args().given("append");
-    vimot::LogFileSink sink(path, append ? vimot::LogFileSink::Mode::kAppend : vimot::LogFileSink::Mode::kReplace);
+    // Flushed per event: a respawned estimator catches up from this file
+    // (--catch-up-log) while the run goes on.
+    vimot::LogFileSink sink(path, append ? vimot::LogFileSink::Mode::kAppend : vimot::LogFileSink::Mode::kReplace,
+                            /*flush_each=*/true);
     if (append && sink.found().file_bytes > 0) {
       const vimot::LogFileTail& found = sink.found();
       vimot::log_warn("appending to ", path, " (", found.events, " events already there",

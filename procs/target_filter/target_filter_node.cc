@@ -75,6 +75,8 @@ VinsNodeOptions vins_node_options(const TargetFilterNodeOptions& o) {
   v.max_queued_frames = o.max_queued_frames;
   v.input = o.input;
   v.checkpoint_path = o.checkpoint_path;
+  v.catch_up_log = o.catch_up_log;
+  v.catch_up_channels = o.catch_up_channels;
   return v;
 }
 }  // namespace
@@ -99,6 +101,7 @@ TargetFilterNode::TargetFilterNode(const TargetFilterNodeOptions& options, Callb
     vins_.set_checkpoint_extension(checkpoint_.get());
   }
   vins_.set_frame_hooks([this](const CameraFrame& frame) { before_frame(frame); }, [this] { after_update(); });
+  vins_.set_ground_truth_hook([this](const GroundTruth& truth) { keep_truth(truth); });
 }
 
 TargetFilterNode::~TargetFilterNode() = default;
@@ -109,9 +112,9 @@ void TargetFilterNode::on_frame(const CameraFrame& frame) { vins_.on_frame(frame
 
 void TargetFilterNode::flush() { vins_.flush(); }
 
-void TargetFilterNode::on_ground_truth(const GroundTruth& message) {
-  GroundTruth truth;
-  if (!vins_.on_ground_truth(message, &truth)) return;  // unit quaternions from here on
+void TargetFilterNode::on_ground_truth(const GroundTruth& message) { vins_.on_ground_truth(message); }
+
+void TargetFilterNode::keep_truth(const GroundTruth& truth) {
   if (filter_ && truth.has_target && options_.target.init_mode == target::TargetInitMode::kGroundTruth) {
     truths_[truth.utime] = truth;
     const int64_t keep_from = truth.utime - static_cast<int64_t>(options_.ground_truth_buffer_s * 1e6);

@@ -55,6 +55,9 @@ struct TargetFilterNodeOptions {
   InputGuardOptions input;
   /// See VinsNodeOptions; with the target filter's state (target_checkpoint.h).
   std::string checkpoint_path;
+  /// See VinsNodeOptions.
+  std::string catch_up_log;
+  CatchUpChannels catch_up_channels;
 };
 
 /// The process's options from config/target_filter.yaml:
@@ -107,6 +110,8 @@ class TargetFilterNode {
   const estimator::CheckpointExtension* checkpoint_extension() const { return checkpoint_.get(); }
 
  private:
+  /// Buffers a usable ground truth (live or caught up) for the target's initialisation.
+  void keep_truth(const GroundTruth& truth);
   void before_frame(const CameraFrame& frame);
   void after_update();
 

@@ -21,12 +21,14 @@ int run(int argc, const char* const* argv) {
                             "start from ground truth perturbed with this seed (overrides init.perturb_seed)");
   process.args().add_option("checkpoint", "PATH",
                             "estimator state file written per update; a restart goes on from it if recent (input.bridge_max_gap_s)");
+  vimot::add_catch_up_option(process.args());
   process.args().add_option("max-wait", "SECONDS",
                             "process a queued camera frame after this much wall time without IMU", "0.5");
   if (!process.init(argc, argv)) return 0;
 
   vimot::VinsNodeOptions options = vimot::vins_node_options_from_config(process.config());
   if (process.args().given("checkpoint")) options.checkpoint_path = process.args().get("checkpoint");
+  vimot::set_catch_up(process, &options, options.init_from_ground_truth);
   if (process.args().given("perturb-seed")) {
     options.perturb_seed = static_cast<uint64_t>(process.args().get_int("perturb-seed"));
   }

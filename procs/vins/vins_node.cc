@@ -1,6 +1,8 @@
 #include "procs/vins/vins_node.h"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -198,11 +200,104 @@ void VinsNode::count_left(EstimatorInput input, int64_t utime) {
   }
 }
 
-void VinsNode::on_imu(const ImuData& imu) {
-  guarded("on_imu", [&] { on_imu_checked(imu); });
+const StreamGuard& VinsNode::guard(EstimatorInput input) const {
+  return input == EstimatorInput::kImu ? imu_guard_ : input == EstimatorInput::kFrame ? frame_guard_ : truth_guard_;
 }
 
-void VinsNode::on_imu_checked(const ImuData& imu) {
+bool VinsNode::enter(EstimatorInput input, int64_t utime) {
+  if (!restore_tried_ && !options_.catch_up_log.empty() && !options_.checkpoint_path.empty()) {
+    estimator::EstimatorCheckpoint c;
+    if (restore_checkpoint(utime, "catching up from " + options_.catch_up_log, &c)) catch_up(c, input, utime);
+  }
+  if (utime > caught_until_[index(input)]) return true;
+  ++already_handled_;
+  return false;
+}
+
+void VinsNode::catch_up(const estimator::EstimatorCheckpoint& c, EstimatorInput live, int64_t live_utime) {
+  // The state's frame and everything before it were handled by the process that wrote the checkpoint.
+  for (int64_t& until : caught_until_) until = c.utime;
+  last_frame_utime_ = c.utime;
+  const std::string& path = options_.catch_up_log;
+  std::unique_ptr<CatchUpLog> log;
+  try {
+    log = std::make_unique<CatchUpLog>(path, options_.catch_up_channels, c.utime);
+  } catch (const std::exception& e) {
+    say(NodeEvent::Kind::kInfo, std::string("no catch-up: ") + e.what() + "; bridging the gap");
+    return;
+  }
+  // IMU samples read before the state's frame arrived before it at the
+  // process too: they are in the estimator's buffer but their IMU-rate
+  // outputs were published from the state before the frame.
+  bool after_state_frame = false;
+  bool reached_live = false;
+  int64_t first = -1, last = -1;
+  int64_t last_imu = c.last_imu.utime;
+  double hole_s = 0.0;
+  int64_t hole_end = -1;
+  LoggedInput m;
+  while (log->next(&m)) {
+    if (m.input == live && m.utime >= live_utime) {
+      reached_live = true;
+      break;
+    }
+    if (m.input == EstimatorInput::kFrame && m.utime == c.utime) after_state_frame = true;
+    if (m.utime <= caught_until_[index(m.input)]) continue;
+    switch (m.input) {
+      case EstimatorInput::kImu: {
+        const double step_s = 1e-6 * static_cast<double>(m.utime - last_imu);
+        if (step_s > hole_s) {
+          hole_s = step_s;
+          hole_end = m.utime;
+        }
+        last_imu = m.utime;
+        on_imu_checked(m.imu, /*publish=*/after_state_frame);
+        break;
+      }
+      case EstimatorInput::kFrame: on_frame_checked(m.frame); break;
+      case EstimatorInput::kGroundTruth: on_ground_truth_checked(m.truth); break;
+    }
+    caught_until_[index(m.input)] = m.utime;
+    ++caught_up_[index(m.input)];
+    if (first < 0) first = m.utime;
+    last = m.utime;
+  }
+  std::ostringstream msg;
+  msg << "caught up " << caught_up_[index(EstimatorInput::kImu)] << " IMU, "
+      << caught_up_[index(EstimatorInput::kFrame)] << " FEATURES, "
+      << caught_up_[index(EstimatorInput::kGroundTruth)] << " GROUND_TRUTH from " << path;
+  if (first >= 0) msg << " (" << first << " → " << last << ")";
+  say(NodeEvent::Kind::kInfo, msg.str());
+  for (const EstimatorInput input : {EstimatorInput::kImu, EstimatorInput::kFrame, EstimatorInput::kGroundTruth}) {
+    if (caught_up_[index(input)] > 0 && on_event_) {
+      on_event_(NodeEvent{NodeEvent::Kind::kCaughtUp, msg.str(), caught_up_[index(input)], guard(input).name()});
+    }
+  }
+  if (log->malformed() > 0) {
+    say(NodeEvent::Kind::kDropped, "catch-up log " + path + ": " + std::to_string(log->malformed()) +
+                                       " malformed messages skipped (first: " + log->first_malformed() + ")");
+  }
+  if (hole_s > options_.input.max_imu_gap_s) {
+    std::ostringstream hole;
+    hole << "catch-up log " << path << " lacks " << hole_s << " s of IMU before utime " << hole_end
+         << " (logger down?): bridging it";
+    say(NodeEvent::Kind::kInfo, hole.str());
+  }
+  if (!reached_live) {
+    std::ostringstream end;
+    end << "catch-up log " << path << " ends " << 1e-6 * static_cast<double>(live_utime - std::max(last, c.utime))
+        << " s before the live input at utime " << live_utime << ": bridging the rest";
+    say(NodeEvent::Kind::kInfo, end.str());
+  }
+}
+
+void VinsNode::on_imu(const ImuData& imu) {
+  guarded("on_imu", [&] {
+    if (enter(EstimatorInput::kImu, imu.utime)) on_imu_checked(imu, /*publish=*/true);
+  });
+}
+
+void VinsNode::on_imu_checked(const ImuData& imu, bool publish) {
   // The clock first: a sample rejected for its values still took its slot
   // in the stream (counted once, as dropped, not again as lost).
   if (!admit(imu_guard_, imu.utime)) return;
@@ -229,11 +324,13 @@ void VinsNode::on_imu_checked(const ImuData& imu) {
   }
   try_restore(imu.utime);
   process_ready_frames(imu.utime);
-  if (options_.publish_imu_rate && queued_frames_.empty()) publish_propagated(imu.utime);
+  if (publish && options_.publish_imu_rate && queued_frames_.empty()) publish_propagated(imu.utime);
 }
 
 void VinsNode::on_frame(const CameraFrame& frame) {
-  guarded("on_frame", [&] { on_frame_checked(frame); });
+  guarded("on_frame", [&] {
+    if (enter(EstimatorInput::kFrame, frame.utime)) on_frame_checked(frame);
+  });
 }
 
 void VinsNode::on_frame_checked(const CameraFrame& frame) {
@@ -311,32 +408,36 @@ std::string VinsNode::absurd_observation(const CameraFrame& frame) const {
   return {};
 }
 
-bool VinsNode::on_ground_truth(const GroundTruth& message, GroundTruth* accepted) {
+bool VinsNode::on_ground_truth(const GroundTruth& message) {
   bool usable = false;
   guarded("on_ground_truth", [&] {
-    GroundTruth truth = message;
-    const bool starting = options_.init_from_ground_truth && !estimator_.initialized();
-    // A start far from the IMU's clock (a future or stale ground truth)
-    // would make every frame "before the state time": wait for a good one.
-    // Such a message never starts the stream's clock (it fills its slot in
-    // a running one, so it is not counted again as lost).
-    const int64_t imu_utime = estimator_.propagator().latest_utime();
-    if (starting && imu_utime >= 0 &&
-        std::abs(1e-6 * static_cast<double>(truth.utime - imu_utime)) > options_.input.max_imu_gap_s) {
-      if (!truth_guard_.started() || admit(truth_guard_, truth.utime)) {
-        say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth.utime) +
-                                           " is too far from the IMU clock (" + std::to_string(imu_utime) +
-                                           ") to initialise from");
-      }
-      return;
-    }
-    if (!admit(truth_guard_, truth.utime) || !check_ground_truth(&truth)) return;
-    usable = true;
-    if (accepted != nullptr) *accepted = truth;
-    if (starting) try_restore(truth.utime);
-    if (starting && !estimator_.initialized()) initialise_from(truth);
+    usable = enter(EstimatorInput::kGroundTruth, message.utime) && on_ground_truth_checked(message);
   });
   return usable;
+}
+
+bool VinsNode::on_ground_truth_checked(const GroundTruth& message) {
+  GroundTruth truth = message;
+  const bool starting = options_.init_from_ground_truth && !estimator_.initialized();
+  // A start far from the IMU's clock (a future or stale ground truth)
+  // would make every frame "before the state time": wait for a good one.
+  // Such a message never starts the stream's clock (it fills its slot in
+  // a running one, so it is not counted again as lost).
+  const int64_t imu_utime = estimator_.propagator().latest_utime();
+  if (starting && imu_utime >= 0 &&
+      std::abs(1e-6 * static_cast<double>(truth.utime - imu_utime)) > options_.input.max_imu_gap_s) {
+    if (!truth_guard_.started() || admit(truth_guard_, truth.utime)) {
+      say(NodeEvent::Kind::kDropped, "ground truth at utime " + std::to_string(truth.utime) +
+                                         " is too far from the IMU clock (" + std::to_string(imu_utime) +
+                                         ") to initialise from");
+    }
+    return false;
+  }
+  if (!admit(truth_guard_, truth.utime) || !check_ground_truth(&truth)) return false;
+  if (starting) try_restore(truth.utime);
+  if (starting && !estimator_.initialized()) initialise_from(truth);
+  if (on_truth_) on_truth_(truth);
+  return true;
 }
 
 void VinsNode::initialise_from(const GroundTruth& truth) {
@@ -347,6 +448,11 @@ void VinsNode::initialise_from(const GroundTruth& truth) {
 
 void VinsNode::try_restore(int64_t input_utime) {
   if (restore_tried_ || options_.checkpoint_path.empty() || estimator_.initialized()) return;
+  estimator::EstimatorCheckpoint c;
+  restore_checkpoint(input_utime, "bridging the gap", &c);
+}
+
+bool VinsNode::restore_checkpoint(int64_t input_utime, const std::string& next, estimator::EstimatorCheckpoint* out) {
   restore_tried_ = true;
   estimator::EstimatorCheckpoint c;
   std::string why;
@@ -355,7 +461,7 @@ void VinsNode::try_restore(int64_t input_utime) {
     // None yet is a normal first start; an unreadable one is a fault.
     const bool absent = why.rfind("no checkpoint", 0) == 0;
     say(absent ? NodeEvent::Kind::kInfo : NodeEvent::Kind::kError, why + start);
-    return;
+    return false;
   }
   const double age_s = 1e-6 * static_cast<double>(input_utime - c.utime);
   if (!(age_s >= 0.0 && age_s <= options_.input.bridge_max_gap_s)) {
@@ -364,17 +470,19 @@ void VinsNode::try_restore(int64_t input_utime) {
         << age_s << " s before the input (limit input.bridge_max_gap_s " << options_.input.bridge_max_gap_s
         << " s)" << start;
     say(NodeEvent::Kind::kInfo, msg.str());
-    return;
+    return false;
   }
   if (!estimator::restore(c, &estimator_, checkpoint_extension_, &why)) {
     say(NodeEvent::Kind::kError, "checkpoint " + options_.checkpoint_path + " rejected: " + why + start);
-    return;
+    return false;
   }
   restored_ = true;
   std::ostringstream msg;
   msg << "restored from checkpoint " << options_.checkpoint_path << " at utime " << c.utime << ", " << age_s
-      << " s before the input: bridging the gap";
+      << " s before the input: " << next;
   say(NodeEvent::Kind::kInfo, msg.str());
+  *out = std::move(c);
+  return true;
 }
 
 void VinsNode::write_checkpoint() {
@@ -490,6 +598,7 @@ void VinsNode::check_consistency() {
 }
 
 void VinsNode::publish_updated() {
+  imu_rate_count_ = 0;  // the IMU-rate phase follows the update (a restored node keeps it)
   if (on_state_) on_state_(estimator::nav_state_of(estimator_, /*updated=*/true));
 }
 

@@ -16,6 +16,7 @@
 // estimate, said as an error. No exception leaves a public call.
 
 #include <cstdint>
+#include <cstddef>
 #include <deque>
 #include <functional>
 #include <string>
@@ -23,6 +24,7 @@
 #include "common/config/config.h"
 #include "common/estimator/checkpoint.h"
 #include "common/estimator/vio_estimator.h"
+#include "common/process/catch_up.h"
 #include "common/process/node_event.h"
 #include "common/process/stream_guard.h"
 #include "common/types/ground_truth.h"
@@ -95,7 +97,8 @@ struct VinsNodeOptions {
   uint64_t perturb_seed{0};
   /// Publish the IMU-rate propagated state (VINS_STATE, updated = false).
   bool publish_imu_rate{true};
-  /// ... every this many IMU samples (>= 1). Each carries a full 15×15
+  /// ... every this many IMU samples (>= 1), counted from each update (so
+  /// a node restored from its checkpoint publishes the same ones). Each carries a full 15×15
   /// covariance (≈ 2 kB) into every subscriber's socket; the camera-rate
   /// consumers (scale_estimator, log evaluation) need only updated states.
   int imu_rate_every{1};
@@ -108,6 +111,13 @@ struct VinsNodeOptions {
   /// when it is at most input.bridge_max_gap_s older than the first input,
   /// bridging the gap (a respawned process). Empty: no checkpoint.
   std::string checkpoint_path;
+  /// With a checkpoint: the run's LCM log (vimot-logger's). A restore at
+  /// the first input first handles, from this log, the input the process
+  /// missed (after the checkpoint's state, up to that first input), so the
+  /// estimate goes on as if it had never stopped; what the log lacks is
+  /// bridged. Empty: the gap is bridged.
+  std::string catch_up_log;
+  CatchUpChannels catch_up_channels;
 };
 
 /// The process's options from a vins config (config/vins.yaml, layout in
@@ -128,9 +138,9 @@ class VinsNode {
 
   void on_imu(const ImuData& imu);
   void on_frame(const CameraFrame& frame);
-  /// True if the message was usable (*accepted: it with unit quaternions);
-  /// false, said as dropped, if not.
-  bool on_ground_truth(const GroundTruth& truth, GroundTruth* accepted = nullptr);
+  /// True if the message was usable (it then went to the ground-truth
+  /// hook with unit quaternions); false, said as dropped, if not.
+  bool on_ground_truth(const GroundTruth& truth);
   /// Processes every queued frame with the IMU data there is.
   void flush();
   /// A message of `input` left unhandled at the stop (the process counts it
@@ -142,6 +152,8 @@ class VinsNode {
   /// frame: `before_frame` runs before the estimator sees a frame,
   /// `after_update` after a processed frame's updated state was published.
   void set_frame_hooks(std::function<void(const CameraFrame&)> before_frame, std::function<void()> after_update);
+  /// Runs on each usable ground truth (unit quaternions), live or caught up.
+  void set_ground_truth_hook(std::function<void(const GroundTruth&)> on_truth) { on_truth_ = std::move(on_truth); }
   /// The attached extension's part of the checkpoint (not owned; set before any input).
   void set_checkpoint_extension(estimator::CheckpointExtension* extension) { checkpoint_extension_ = extension; }
 
@@ -152,6 +164,12 @@ class VinsNode {
   int64_t bridged_gaps() const { return bridged_gaps_; }
   /// True once the estimate was restored from the checkpoint.
   bool restored() const { return restored_; }
+  /// Messages of `input` handled from the catch-up log.
+  int64_t caught_up(EstimatorInput input) const { return caught_up_[index(input)]; }
+  /// Live messages not handled again: the checkpoint's state or the catch-up had them.
+  int64_t already_handled() const { return already_handled_; }
+  /// The input stream's timing guard (its lost and rejected counts).
+  const StreamGuard& guard(EstimatorInput input) const;
   /// Validates a ground-truth message's values in place (quaternions
   /// normalised); false, said as dropped, if it is unusable.
   bool check_ground_truth(GroundTruth* truth);
@@ -177,13 +195,27 @@ class VinsNode {
   void reset_estimate(const std::string& why, bool clean_clock);
   /// Applies a stream guard's verdict; false if the message is to be dropped.
   bool admit(StreamGuard& guard, int64_t utime);
-  void on_imu_checked(const ImuData& imu);
+  static std::size_t index(EstimatorInput input) { return static_cast<std::size_t>(input); }
+  /// Before each input: at the first, the restore and catch-up
+  /// (--catch-up-log); false if the message was handled already.
+  bool enter(EstimatorInput input, int64_t utime);
+  /// Handles the logged input after the checkpoint's state `c` up to the
+  /// first live message (`live` at `live_utime`), in log order; says what
+  /// it did and what the log lacks.
+  void catch_up(const estimator::EstimatorCheckpoint& c, EstimatorInput live, int64_t live_utime);
+  /// `publish`: false for a sample the process had before its checkpoint's
+  /// update (its IMU-rate output was published from the state before).
+  void on_imu_checked(const ImuData& imu, bool publish);
+  bool on_ground_truth_checked(const GroundTruth& message);
   void on_frame_checked(const CameraFrame& frame);
   void check_consistency();
   void initialise_from(const GroundTruth& truth);
   /// At the first input only: restores the checkpoint if it is usable and
   /// at most bridge_max_gap_s before `input_utime`; says what it did.
   void try_restore(int64_t input_utime);
+  /// The restore of try_restore into *c; says why not, or that it restored
+  /// and what comes `next`.
+  bool restore_checkpoint(int64_t input_utime, const std::string& next, estimator::EstimatorCheckpoint* c);
   void write_checkpoint();
   /// True (said) if a step of `gap_s` forward in the input is bridged.
   bool bridges(double gap_s, const std::string& what);
@@ -194,6 +226,7 @@ class VinsNode {
   EventCallback on_event_;
   std::function<void(const CameraFrame&)> before_frame_;
   std::function<void()> after_update_;
+  std::function<void(const GroundTruth&)> on_truth_;
   estimator::CheckpointExtension* checkpoint_extension_{nullptr};
   std::deque<CameraFrame> queued_frames_;
   int64_t last_frame_utime_{-1};
@@ -201,6 +234,10 @@ class VinsNode {
   int64_t bridged_gaps_{0};
   bool restore_tried_{false};
   bool restored_{false};
+  int64_t caught_up_[3]{0, 0, 0};
+  /// Per input: the newest utime handled before or in the catch-up.
+  int64_t caught_until_[3]{INT64_MIN, INT64_MIN, INT64_MIN};
+  int64_t already_handled_{0};
   bool checkpoint_failed_{false};  // said once
   StreamGuard imu_guard_;
   StreamGuard frame_guard_;

@@ -29,21 +29,36 @@ std::string temp_log(const std::string& name) {
 }
 
 /// 3 s of sim_paper (seed 2) and a VinsNode's states on it; `keep(i, bytes)`
-/// decides what the "logger" writes of the i-th state (false: lost).
-void write_live_log(const std::string& path, const std::function<bool(int, std::vector<uint8_t>*)>& keep) {
+/// decides what the "logger" writes of the i-th state (false: lost). Before
+/// state `republish_at`, the `republish` states before it are written again
+/// (a process respawned from a checkpoint written before them), the first
+/// copy with one bit flipped if `flip_copy`.
+void write_live_log(const std::string& path, const std::function<bool(int, std::vector<uint8_t>*)>& keep,
+                    int republish_at = -1, int republish = 0, bool flip_copy = false) {
   sim::SimConfig cfg = sim::from_config(Config::load_file(VIMOT_SOURCE_DIR "/config/sim_paper.yaml"));
   cfg.seed = 2;
   cfg.duration = 3.0;
   sim::Simulator sim(cfg);
   LogFileSink log(path);
   int state_index = 0;
+  std::vector<std::vector<uint8_t>> written;
   VinsNode node(
       vins_node_options_from_config(Config::load_file(kVinsConfig)),
       [&](const NavState& s) {
         const nav_state_t msg = to_lcm(s);
         std::vector<uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
         msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-        if (keep(state_index++, &bytes)) log.write("VINS_STATE", msg.utime, bytes.data(), static_cast<int>(bytes.size()));
+        if (state_index == republish_at) {
+          for (std::size_t k = written.size() - static_cast<std::size_t>(republish); k < written.size(); ++k) {
+            std::vector<uint8_t> copy = written[k];
+            if (flip_copy && k + static_cast<std::size_t>(republish) == written.size()) copy.back() ^= 1;
+            log.write("VINS_STATE", msg.utime, copy.data(), static_cast<int>(copy.size()));
+          }
+        }
+        if (keep(state_index++, &bytes)) {
+          log.write("VINS_STATE", msg.utime, bytes.data(), static_cast<int>(bytes.size()));
+          written.push_back(bytes);
+        }
       },
       [](const NodeEvent&) {});
   while (const auto event = sim.next()) {
@@ -104,4 +119,22 @@ TEST_CASE("replay_log counts states the logger lost and finds a changed one") {
   CHECK(d.first_difference == 20);
   CHECK(d.identical == 20);
   CHECK(d.first_difference_utime > 0);
+}
+
+TEST_CASE("replay_log takes the states a respawned process published again as republished copies") {
+  const std::string again = temp_log("again");
+  write_live_log(again, [](int, std::vector<uint8_t>*) { return true; }, 40, 6);
+  const ChannelComparison r = replay(again);
+  CHECK(r.equal());
+  CHECK(r.republished == 6);
+  CHECK(r.identical == r.replayed);
+  CHECK(r.recorded == r.replayed + 6);
+  CHECK(r.not_logged == 0);
+
+  const std::string changed = temp_log("again_changed");
+  write_live_log(changed, [](int, std::vector<uint8_t>*) { return true; }, 40, 6, /*flip_copy=*/true);
+  const ChannelComparison d = replay(changed);
+  CHECK_FALSE(d.equal());
+  CHECK(d.first_difference == 40);  // the copy of state 34, recorded after the first 40
+  CHECK(d.republished == 0);
 }

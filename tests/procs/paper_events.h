@@ -1,6 +1,9 @@
 #pragma once
 // The paper scenario's event stream for the process-logic tests.
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <variant>
@@ -25,16 +28,30 @@ inline std::vector<sim::SimEvent> simulate(double duration) {
   return events;
 }
 
-/// Feeds `events` to a node (VinsNode, TargetFilterNode) in order, then flushes it.
+/// Feeds one event to a node (VinsNode, TargetFilterNode).
+template <typename Node>
+void feed_one(Node& node, const sim::SimEvent& e) {
+  if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
+  if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
+  if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
+}
+
+/// Feeds `events` to a node in order, then flushes it.
 template <typename Node>
 void feed(Node& node, const std::vector<sim::SimEvent>& events) {
-  for (const auto& e : events) {
-    if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
-    if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
-    if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
-  }
+  for (const auto& e : events) feed_one(node, e);
   node.flush();
 }
+
+/// A folder for a test's files, removed with everything in it at the end.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() : path(std::filesystem::temp_directory_path() / ("vimot_procs_test_" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
 
 /// Every camera frame but the first moved before the last 5 IMU samples up
 /// to its time, as if it arrived early on the network (the first stays after

@@ -15,7 +15,6 @@
 #include <fstream>
 #include <map>
 #include <string>
-#include <unistd.h>
 #include <variant>
 #include <vector>
 
@@ -150,15 +149,6 @@ const Run& clean_run() {
   static const Run run = run_vins(all_events());
   return run;
 }
-
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() : path(std::filesystem::temp_directory_path() / ("vimot_recovery_test_" + std::to_string(::getpid()))) {
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
 
 }  // namespace
 
@@ -444,13 +434,6 @@ struct TargetFilterOutput {
   }
   bool said(NodeEvent::Kind kind, const std::string& text) const { return said_in(events, kind, text); }
 };
-
-template <typename Node>
-void feed_one(Node& node, const sim::SimEvent& e) {
-  if (const auto* imu = std::get_if<ImuData>(&e)) node.on_imu(*imu);
-  if (const auto* frame = std::get_if<CameraFrame>(&e)) node.on_frame(*frame);
-  if (const auto* gt = std::get_if<GroundTruth>(&e)) node.on_ground_truth(*gt);
-}
 
 }  // namespace
 
