@@ -42,6 +42,8 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${VIMOT_BUILD_DIR:-$here/build}/bin"
+# shellcheck source=scripts/run_figures.sh
+source "$here/scripts/run_figures.sh"  # evaluate, rmse_vio, rmse_target
 
 mode=local
 victims="vins target_filter sim logger"
@@ -162,17 +164,8 @@ run() {
   echo "$rc" > "$dir/replay.rc"
 }
 
-# evaluate DIR LOG: vimot-log-eval of VINS_STATE and of NAV_STATE + TARGET_STATE.
-evaluate() {
-  local dir="$1" log="$2"
-  "$bin/vimot-log-eval" "$log" > "$dir/vins_eval.txt" 2>&1 || true
-  "$bin/vimot-log-eval" "$log" --state-channel NAV_STATE --target-channel TARGET_STATE --own-target-frame \
-    > "$dir/target_eval.txt" 2>&1 || true
-}
 
 gap() { awk -v c="$2" '$1 == c { print $7 }' "$1/summary.txt"; }
-rmse_vio() { awk '$1 == "samples" { print $5 }' "$1/$2"; }
-rmse_target() { awk -v w="$2" '$0 ~ "^target in " w { for (i = 1; i <= NF; ++i) if ($i == "RMSE") { print $(i + 1); exit } }' "$1/target_eval.txt"; }
 metric() {  # metric NAME DIR
   case "$1" in
     VINS_STATE) rmse_vio "$2" vins_eval.txt ;;

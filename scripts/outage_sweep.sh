@@ -21,6 +21,8 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${VIMOT_BUILD_DIR:-$here/build}/bin"
+# shellcheck source=scripts/run_figures.sh
+source "$here/scripts/run_figures.sh"  # evaluate, rmse_vio, rmse_target
 
 seeds="$(seq -s ' ' 1 10)"
 at_list="21.0"
@@ -57,9 +59,7 @@ run_one() {
   "$bin/vimot-log-replay" --vins "$config/vins.yaml" --target-filter "$config/target_filter.yaml" \
     --out "$dir/replayed.lcm" "$dir/sim.lcm" > "$dir/replay.txt" 2>&1 || rc=$?
   [ "$rc" = 0 ] || [ "$rc" = 2 ] || { echo "outage_sweep.sh: replay failed, see $dir/replay.txt" >&2; return 1; }
-  "$bin/vimot-log-eval" "$dir/replayed.lcm" > "$dir/vins_eval.txt" 2>&1
-  "$bin/vimot-log-eval" "$dir/replayed.lcm" --state-channel NAV_STATE --target-channel TARGET_STATE \
-    --own-target-frame > "$dir/target_eval.txt" 2>&1
+  evaluate "$dir" "$dir/replayed.lcm"
   rm -f "$dir/sim.lcm" "$dir/replayed.lcm"
 }
 
@@ -69,13 +69,11 @@ for s in $seeds; do
   for a in $at_list; do runs+=("$out/seed$s/outage_at_$a $s $a"); done
 done
 echo "outage_sweep: ${#runs[@]} runs (seeds: $seeds; outage ${length} s at: $at_list) on $jobs jobs, in $out"
-export -f run_one
+export -f run_one evaluate
 export bin config sim_config length
 failed=0
 printf '%s\n' "${runs[@]}" | xargs -P "$jobs" -L 1 bash -c 'run_one "$0" "$@" && echo "  done $0"' || failed=1
 
-rmse_vio() { awk '$1 == "samples" { print $5 }' "$1/$2"; }
-rmse_target() { awk -v w="$2" '$0 ~ "^target in " w { for (i = 1; i <= NF; ++i) if ($i == "RMSE") { print $(i + 1); exit } }' "$1/target_eval.txt"; }
 figures() { echo "$(rmse_vio "$1" vins_eval.txt) $(rmse_vio "$1" target_eval.txt) $(rmse_target "$1" world) $(rmse_target "$1" IMU)"; }
 
 {
