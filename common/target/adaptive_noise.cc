@@ -17,11 +17,13 @@ void AdaptiveNoiseOptions::validate() const {
   }
   if (!(nis_max > 1.0)) throw std::invalid_argument("adaptive: nis_max must be > 1");
   if (!(max_step > 1.0) || !std::isfinite(max_step)) throw std::invalid_argument("adaptive: max_step must be > 1");
+  if (!(hold_s >= 0.0) || !std::isfinite(hold_s)) throw std::invalid_argument("adaptive: hold_s must be >= 0");
 }
 
 AdaptiveNoise::AdaptiveNoise(const AdaptiveNoiseOptions& options, double sigma0) : options_(options) {
   options_.validate();
   sigma_ = std::clamp(sigma0, options_.sigma_min, options_.sigma_max);
+  matched_ = sigma_;
 }
 
 void AdaptiveNoise::add_innovation(double chi2, int dof) {
@@ -65,6 +67,7 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
   frame_chi2_ = 0.0;
   frame_dof_ = 0;
   inflation_ = 0.0;
+  time_ += f.dt;
   const double frame_nis = f.dof > 0 ? f.chi2 / f.dof : 0.0;
   if (f.dof > 0 && f.chi2 > options_.nis_max * estimator::chi2_quantile(0.99, f.dof)) {
     ++violations_;
@@ -89,7 +92,11 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
     }
     // Half a window of evidence before σ̂ replaces the current value.
     if (unit > 0.0 && 2 * static_cast<int>(window_.size()) >= options_.window) {
-      sigma_ = std::clamp(std::sqrt(std::max(q / unit, 0.0)), options_.sigma_min, options_.sigma_max);
+      matched_ = std::clamp(std::sqrt(std::max(q / unit, 0.0)), options_.sigma_min, options_.sigma_max);
+      while (!recent_.empty() && recent_.front().first < time_ - options_.hold_s) recent_.pop_front();
+      while (!recent_.empty() && recent_.back().second <= matched_) recent_.pop_back();  // never the max again
+      recent_.emplace_back(time_, matched_);
+      sigma_ = recent_.front().second;
     }
   }
   consistent_ = frames_since_violation_ >= options_.window && window_nis() <= options_.nis_max;
@@ -97,6 +104,13 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
 
 void AdaptiveNoise::save(estimator::CheckpointWriter* out) const {
   out->put(sigma_);
+  out->put(matched_);
+  out->put(time_);
+  out->put(static_cast<int64_t>(recent_.size()));
+  for (const auto& [time, sigma] : recent_) {
+    out->put(time);
+    out->put(sigma);
+  }
   out->put(static_cast<int64_t>(window_.size()));
   for (const Frame& f : window_) out->put(f);
   out->put(frame_chi2_);
@@ -110,6 +124,15 @@ void AdaptiveNoise::save(estimator::CheckpointWriter* out) const {
 bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
   AdaptiveNoise a = *this;
   a.sigma_ = in->take<double>();
+  a.matched_ = in->take<double>();
+  a.time_ = in->take<double>();
+  const int64_t r = in->take<int64_t>();
+  if (r < 0 || static_cast<uint64_t>(r) > in->left() / (2 * sizeof(double))) return false;
+  a.recent_.clear();
+  for (int64_t i = 0; i < r; ++i) {
+    const double time = in->take<double>();
+    a.recent_.emplace_back(time, in->take<double>());
+  }
   const int64_t n = in->take<int64_t>();
   if (n < 0 || n > options_.window) return false;
   a.window_.clear();

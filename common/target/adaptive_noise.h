@@ -23,6 +23,13 @@
 // was computed with a σ now judged wrong). The model is judged consistent (tight
 // coupling allowed) once `window` frames have passed without a violation and
 // the windowed NIS is at most nis_max.
+//
+// Hold: the σ used is the largest windowed estimate of the last hold_s
+// seconds. The matched σ̂ is the target's *mean* density; a manoeuvring
+// target (stops, speed changes) exceeds it for seconds at a time, and a σ
+// too small then corrupts the robot (the paper's Table I) while one too
+// large only forgoes part of the gain. So the estimate follows the target's
+// hardest recent manoeuvre up at once and forgets it only after hold_s.
 
 #include <Eigen/Core>
 #include <deque>
@@ -41,6 +48,7 @@ struct AdaptiveNoiseOptions {
   /// χ²(Σdof) and the plain quantile would flag consistent frames.
   double nis_max{2.0};
   double max_step{4.0};     // largest σ² factor of one violating frame
+  double hold_s{0.0};       // [s] σ = the largest windowed σ̂ of this long (0: the latest)
   /// Throws std::invalid_argument naming the bad option.
   void validate() const;
 };
@@ -60,6 +68,8 @@ class AdaptiveNoise {
   void end_frame_innovations_only();
 
   double sigma() const { return sigma_; }
+  /// The latest windowed estimate (the mean density), before the hold.
+  double matched_sigma() const { return matched_; }
   bool consistent() const { return consistent_; }
   double window_nis() const;
   int64_t violations() const { return violations_; }
@@ -84,6 +94,9 @@ class AdaptiveNoise {
 
   AdaptiveNoiseOptions options_;
   double sigma_;
+  double matched_;
+  double time_{0.0};                               // Σ dt of the frames so far
+  std::deque<std::pair<double, double>> recent_;   // (time_, windowed σ̂) of the last hold_s
   std::deque<Frame> window_;
   double frame_chi2_{0.0};
   int frame_dof_{0};
