@@ -48,10 +48,9 @@
 #   VIMOT_SPEED       simulator real-time factor (default 2; mono and
 #                     pixels-truthbox: 1, the object tracker's bundle
 #                     adjustment takes ≈ 20 ms per frame; pixels: 0.25, the
-#                     network takes ≈ 70 ms per image; mono-pixels: 0.5, but
-#                     the object tracker takes ≈ 200 ms per frame on the long
-#                     target KLT tracks, so it falls behind and the demo fails
-#                     (exit 4) unless the speed is lower, docs/scale_estimator.md;
+#                     network takes ≈ 70 ms per image; mono-pixels: 0.5, the
+#                     object tracker takes ≈ 13 ms per frame there,
+#                     docs/scale_estimator.md;
 #                     on 2 cores at 4x UDP already loses IMU messages, which
 #                     the heartbeats count, and the demo then fails)
 #   VIMOT_SEED        noise seed (default 1)

@@ -349,8 +349,20 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
     if (c == 1 && o.stereo_klt()) continue;  // right points come from the left ones (match_target_stereo_klt)
     const std::size_t tracked = cur[c].size();
     const double min_d2 = o.min_distance_px * o.min_distance_px;
-    for (const OrbFeature& f : orb_.detect(images[c], *boxes[c])) {
+    const Box& box = *boxes[c];
+    const auto cell_of = [&](const cv::Point2f& px) {
+      const auto index = [&](double x, double lo, double size) {
+        return std::clamp(static_cast<int>((x - lo) / std::max(size, 1e-9) * o.grid), 0, o.grid - 1);
+      };
+      return index(px.y, box.y_min, box.height) * o.grid + index(px.x, box.x_min, box.width);
+    };
+    const int cell_capacity = (o.num_features + o.grid * o.grid - 1) / (o.grid * o.grid);
+    std::vector<int> in_cell(static_cast<std::size_t>(o.grid * o.grid), 0);
+    for (const TargetPoint& t : cur[c]) ++in_cell[static_cast<std::size_t>(cell_of(t.point.pixel))];
+    for (const OrbFeature& f : orb_.detect(images[c], box)) {
       if (cur[c].size() >= static_cast<std::size_t>(o.num_features)) break;
+      int& cell_count = in_cell[static_cast<std::size_t>(cell_of(f.pixel))];
+      if (cell_count >= cell_capacity) continue;
       const bool near_tracked = std::any_of(cur[c].begin(), cur[c].begin() + static_cast<std::ptrdiff_t>(tracked),
                                             [&](const TargetPoint& t) {
                                               const cv::Point2f d = t.point.pixel - f.pixel;
@@ -363,6 +375,7 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
       if (!normalize(cam, &t.point)) continue;
       if (o.anchor_align && !anchor(cam, &t.point)) continue;
       cur[c].push_back(t);
+      ++cell_count;
     }
     for (const TargetPoint& t : cur[c]) cur_desc[c].push_back(t.descriptor);
   }

@@ -15,7 +15,9 @@ int hamming_distance(const Descriptor& a, const Descriptor& b) {
 }
 
 OrbBoxDetector::OrbBoxDetector(const TargetTrackOptions& o)
-    : orb_(cv::ORB::create(o.num_features, static_cast<float>(o.orb_scale_factor), o.orb_levels,
+    // With a grid every cell must find candidates, not only the cells of
+    // the strongest corners: as many candidates as the cells could take.
+    : orb_(cv::ORB::create(o.num_features * o.grid * o.grid, static_cast<float>(o.orb_scale_factor), o.orb_levels,
                            /*edgeThreshold=*/31, /*firstLevel=*/0, /*WTA_K=*/2, cv::ORB::HARRIS_SCORE,
                            /*patchSize=*/31, o.orb_fast_threshold)) {
   // ORB needs a 31-pixel patch (scaled by the pyramid) around a keypoint; the
@@ -45,9 +47,12 @@ std::vector<OrbFeature> OrbBoxDetector::detect(const cv::Mat& image, const Box& 
     f.pixel = cv::Point2f(kps[i].pt.x + static_cast<float>(roi.x), kps[i].pt.y + static_cast<float>(roi.y));
     // The mask admits whole pixels; the box is the exact test.
     if (!box.contains(f.pixel.x, f.pixel.y)) continue;
+    f.response = kps[i].response;
     std::memcpy(f.descriptor.data(), desc.ptr<uint8_t>(static_cast<int>(i)), sizeof(Descriptor));
     out.push_back(f);
   }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const OrbFeature& a, const OrbFeature& b) { return a.response > b.response; });
   return out;
 }
 

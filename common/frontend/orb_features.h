@@ -24,6 +24,7 @@ int hamming_distance(const Descriptor& a, const Descriptor& b);
 
 struct OrbFeature {
   cv::Point2f pixel;
+  float response{0.0f};  // Harris score
   Descriptor descriptor{};
 };
 
@@ -31,9 +32,10 @@ class OrbBoxDetector {
  public:
   explicit OrbBoxDetector(const TargetTrackOptions& options);
 
-  /// At most options.num_features ORB features of an 8-bit grey image whose
-  /// keypoints lie inside `box` (clipped to the image); descriptors may use
-  /// pixels around the box. Empty if the box misses the image.
+  /// At most options.num_features · grid² ORB features of an 8-bit grey
+  /// image whose keypoints lie inside `box` (clipped to the image),
+  /// strongest first; descriptors may use pixels around the box. Empty if
+  /// the box misses the image.
   std::vector<OrbFeature> detect(const cv::Mat& image, const Box& box) const;
 
  private:

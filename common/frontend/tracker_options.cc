@@ -63,6 +63,7 @@ void TargetTrackOptions::validate() const {
   require(frame_to_frame == "orb" || frame_to_frame == "klt",
           "target.frame_to_frame must be orb or klt, got '" + frame_to_frame + "'");
   require(min_distance_px >= 0.0, "target.min_distance_px must be >= 0");
+  require(grid >= 1, "target.grid must be >= 1");
   require(stereo == "descriptor" || stereo == "klt", "target.stereo must be descriptor or klt, got '" + stereo + "'");
   require(klt() || (!stereo_klt() && !anchor_align),
           "target.stereo klt and target.anchor_align need target.frame_to_frame klt");
@@ -92,7 +93,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
              "max_motion_px", "loop_closure_max_hamming", "max_stored_points", "frame_to_frame", "min_distance_px",
-             "stereo", "anchor_align"});
+             "stereo", "anchor_align", "grid"});
   only_keys(cfg, s + "ransac", {"threshold_px", "confidence", "max_iterations", "min_points", "seed"});
 
   StaticTrackOptions& st = o.static_tracks;
@@ -127,6 +128,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "target.min_distance_px", &t.min_distance_px);
   read(cfg, s + "target.stereo", &t.stereo);
   read(cfg, s + "target.anchor_align", &t.anchor_align);
+  read(cfg, s + "target.grid", &t.grid);
 
   RansacOptions& r = o.ransac;
   read(cfg, s + "ransac.threshold_px", &r.threshold_px);

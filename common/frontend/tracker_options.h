@@ -88,6 +88,14 @@ struct TargetTrackOptions {
   // anchor patch (the static anchor_* options), so a target track does not
   // drift as it lives on.
   bool anchor_align{false};
+  // The box split into grid x grid cells, each holding at most
+  // ceil(num_features / grid²) target points (followed ones first), new
+  // ORB corners taken strongest first per cell. ORB ranks corners by their
+  // Harris response, which grows with the fourth power of the contrast, so
+  // with one cell (grid 1) a brightly lit face takes every slot and the
+  // shaded faces of the same object get none; points on one face only are
+  // a planar structure the monocular object tracker cannot resolve.
+  int grid{1};
   void validate() const;
 };
 

@@ -33,9 +33,8 @@ constexpr float kShadeWallX = 0.9f;
 constexpr float kShadeWallY = 0.8f;
 constexpr float kShadeFloor = 1.0f;
 constexpr float kShadeCeiling = 0.75f;
-// Target faces: ambient + Lambert term under a fixed light from above.
-constexpr float kTargetAmbient = 0.45f;
-constexpr float kTargetDiffuse = 0.55f;
+// Target faces: ambient (render.target_ambient) + Lambert term under a
+// fixed light from above.
 const Eigen::Vector3d kLightDirG = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
 
 // The target texture: a pattern with stronger contrast than the scene's and
@@ -361,8 +360,9 @@ RenderedView Renderer::render_camera(int cam, int64_t utime, const Eigen::Matrix
     for (int k = 0; k < 3; ++k) {
       const double lambert = std::max(0.0, R_TtoG.col(k).dot(kLightDirG));
       const double lambert_neg = std::max(0.0, -R_TtoG.col(k).dot(kLightDirG));
-      face_shade[k][0] = static_cast<float>(kTargetAmbient + kTargetDiffuse * lambert);
-      face_shade[k][1] = static_cast<float>(kTargetAmbient + kTargetDiffuse * lambert_neg);
+      const double ambient = config_.target_ambient;
+      face_shade[k][0] = static_cast<float>(ambient + (1.0 - ambient) * lambert);
+      face_shade[k][1] = static_cast<float>(ambient + (1.0 - ambient) * lambert_neg);
     }
     const Eigen::Matrix3d R_GtoC = R_CtoG.transpose();
     int in_front = 0;

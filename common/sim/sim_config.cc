@@ -50,6 +50,8 @@ std::string render_problem(const SimConfig& c) {
     err << "key 'render.exposure_amplitude' must be in [0, 2] (log gain), got " << fmt(r.exposure_amplitude);
   } else if (!(r.exposure_frequency_hz >= 0.0) || !std::isfinite(r.exposure_frequency_hz)) {
     err << "key 'render.exposure_frequency_hz' must be >= 0, got " << fmt(r.exposure_frequency_hz);
+  } else if (!(r.target_ambient >= 0.0 && r.target_ambient <= 1.0)) {
+    err << "key 'render.target_ambient' must be in [0, 1], got " << fmt(r.target_ambient);
   } else if (r.scene_texture == SurfaceTexture::kCheckerboard &&
              !(whole_multiple(r.checker_square, r.texel_size) &&
                r.texture_size % (2 * static_cast<int>(std::lround(r.checker_square / r.texel_size))) == 0)) {
@@ -498,7 +500,8 @@ SimConfig from_config(const Config& config) {
   r.read("mono.spline_dt", &c.mono.spline_dt);
 
   r.only_keys("render", {"texel_size", "texture_size", "target_texture_size", "scene_texture", "target_texture",
-                         "checker_square", "noise_sigma", "exposure_amplitude", "exposure_frequency_hz"});
+                         "checker_square", "noise_sigma", "exposure_amplitude", "exposure_frequency_hz",
+                         "target_ambient"});
   r.read("render.texel_size", &c.render.texel_size);
   r.read("render.texture_size", &c.render.texture_size);
   r.read("render.target_texture_size", &c.render.target_texture_size);
@@ -513,6 +516,7 @@ SimConfig from_config(const Config& config) {
   r.read("render.checker_square", &c.render.checker_square);
   r.read("render.noise_sigma", &c.render.noise_sigma);
   r.read("render.exposure_amplitude", &c.render.exposure_amplitude);
+  r.read("render.target_ambient", &c.render.target_ambient);
   r.read("render.exposure_frequency_hz", &c.render.exposure_frequency_hz);
 
   const std::string p = problem(c);

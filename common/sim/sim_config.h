@@ -211,6 +211,12 @@ struct RenderConfig {
   /// exp(exposure_amplitude sin(2π exposure_frequency_hz t + φ)), φ from the seed.
   double exposure_amplitude{0.1};
   double exposure_frequency_hz{0.05};  // Hz
+  /// Share of the target's light that is ambient (light from the room,
+  /// the same on every face); the rest, 1 − target_ambient, comes from a
+  /// fixed light from above (Lambert). 0.45 is a single strong light: the
+  /// faces turned from it show their texture at less than half the
+  /// contrast of the lit top.
+  double target_ambient{0.45};
 };
 
 struct SimConfig {

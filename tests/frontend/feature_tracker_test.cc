@@ -215,6 +215,40 @@ TEST_CASE("features inside the target box are ORB target features, outside stati
   for (const auto& [id, px] : t1) CHECK(s0.count(id) == 0);
 }
 
+TEST_CASE("target.grid spreads the target features over the box: a shaded half gets its share") {
+  // The target's right half at 0.45 of the left's brightness, as a face
+  // turned from the light (the rendered mono scenario's default shading).
+  const CameraCalibration cam = test::pinhole(640, 480, 400.0);
+  const cv::Mat background = test::make_texture(640, 480, 21, 1500);
+  cv::Mat patch = test::make_texture(kPatchW, kPatchH, 22, 150);
+  cv::Mat shaded = patch(cv::Rect(kPatchW / 2, 0, kPatchW - kPatchW / 2, kPatchH));
+  shaded.convertTo(shaded, -1, 0.45);
+  const cv::Point at(200, 150);
+  const auto halves = [&](int grid) {
+    FeatureTrackerOptions options;
+    options.target.num_features = 40;
+    options.target.grid = grid;
+    FeatureTracker tracker(options, {cam});
+    const CameraFrame f = tracker.track(0, scene(background, patch, at), cv::Mat(), box_at(at), std::nullopt);
+    std::pair<int, int> lit_shaded{0, 0};
+    for (const auto& [id, px] : pixels_of(f, 0, true)) {
+      (px.x() < at.x + 0.5 * (kPatchW - 1) ? lit_shaded.first : lit_shaded.second) += 1;
+    }
+    return lit_shaded;
+  };
+  const auto [lit1, shaded1] = halves(1);
+  const auto [lit2, shaded2] = halves(2);
+  INFO("grid 1: " << lit1 << " lit, " << shaded1 << " shaded; grid 2: " << lit2 << " lit, " << shaded2 << " shaded");
+  // One cell: ORB's Harris ranking (contrast to the fourth power) fills the
+  // 40 slots from the lit half.
+  CHECK(lit1 + shaded1 == 40);
+  CHECK(shaded1 < lit1 / 2);
+  // 2 x 2 cells of at most 10: the lit half's two cells hold 20, the
+  // shaded half's corners fill the rest.
+  CHECK(lit2 <= 20);
+  CHECK(shaded2 >= 15);
+}
+
 TEST_CASE("a target that leaves and comes back gets its old ids back (target loop closure)") {
   const CameraCalibration cam = test::pinhole(640, 480, 400.0);
   const cv::Mat background = test::make_texture(640, 480, 31, 1500);

@@ -6,15 +6,14 @@
 // from the renderer's ray cast of its reference features
 // (eval::object_truth_from_pixels), so nothing here uses the simulator's
 // feature ids. The metric scale needs a 40 s window: its figures are
-// vimot-scale-eval --pixels (docs/scale_estimator.md). From pixels nearly
-// all target points lie on the box's top face (the shaded side faces give
-// the front end few corners): a planar point set under a near-affine view,
-// whose structure is a family, not the pair of Necker hypotheses. The
-// tracker then used to commit to a wrong member (79 deg at the first valid
-// frame, 0.05 px RMS); its thickness gate (init_min_thickness) now refuses
-// to initialise on it (docs/object_tracker.md, "Initialisation"). Not
-// enough yet: on seed 2 a wrong structure passes the gate after 5 s
-// (docs/object_tracker.md, "Open issues").
+// vimot-scale-eval --pixels (docs/scale_estimator.md). With the target's
+// points on its top face only (one lit face took every ORB slot) the
+// structure was planar and the tracker committed to a wrong member of its
+// family (79 deg); with points on the shaded faces too (target.grid,
+// render.target_ambient; docs/feature_tracker.md, "Target points on every
+// face") a track starts on the right structure. Its unit still drifts by a
+// few per cent over 60 s (docs/scale_estimator.md, "From pixels"), which
+// the position case shows.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -121,19 +120,30 @@ const PixelRun& pixel_run() {
 
 }  // namespace
 
-TEST_CASE("object tracker from rendered pixels: no track on a wrong structure", "[object_tracker][pixels]") {
+TEST_CASE("object tracker from rendered pixels: a track starts on the right structure and holds",
+          "[object_tracker][pixels]") {
   const PixelRun& run = pixel_run();
   INFO("valid " << run.valid << " of " << run.frames_after_init << " frames after the first initialisation, "
                 << run.tracks << " tracks; centre ray vs the box centre's ray " << run.centre_ray_error_deg
                 << " deg; pose against truth: position RMS " << run.position_rms_m << " m (max "
                 << run.position_max_m << "), rotation RMS " << run.rotation_rms_deg << " deg (max "
                 << run.rotation_max_deg << ")");
-  // Every pose the tracker gives is right (no gross error, as the
-  // feature-level tests' 5 deg); a track, if one starts, holds.
-  CHECK(run.rotation_max_deg < 5.0);
+  // One track, never lost.
+  REQUIRE(run.tracks == 1);
   CHECK(run.valid == run.frames_after_init);
-  if (run.tracks > 0) {
-    CHECK(run.centre_ray_error_deg >= 0.0);
-    CHECK(run.centre_ray_error_deg < 0.2);  // 1.6 px at f = 458 px
-  }
+  // No gross error: the feature-level tests' bound (object_tracker_test,
+  // rotation RMS < 5 deg); a wrong structure is 20-170 deg off.
+  CHECK(run.rotation_rms_deg < 5.0);
+  CHECK(run.centre_ray_error_deg >= 0.0);
+  CHECK(run.centre_ray_error_deg < 0.2);  // 1.6 px at f = 458 px
+}
+
+TEST_CASE("object tracker from rendered pixels: position as accurate as at feature level",
+          "[object_tracker][pixels][!shouldfail]") {
+  // The feature-level bound (object_tracker_test, seed 1, 1 px: 0.05 m).
+  // From pixels the tracker's unit drifts by 1-3 % within these 6 s
+  // (0.07 m RMS), 2-6 % over 60 s: docs/scale_estimator.md, "From pixels".
+  const PixelRun& run = pixel_run();
+  INFO("position RMS " << run.position_rms_m << " m (max " << run.position_max_m << ")");
+  CHECK(run.position_rms_m < 0.05);
 }

@@ -308,6 +308,42 @@ TEST_CASE("renderer: the images are a function of the seeds and the utime only")
   CHECK(corr > 0.9);
 }
 
+TEST_CASE("renderer: render.target_ambient shades the target's faces only, between ambient and full light") {
+  SimConfig config = test::load_config("config/sim_mono.yaml");
+  config.render.noise_sigma = 0.0;
+  config.render.exposure_amplitude = 0.0;
+  config.render.target_ambient = 1.0;  // every face unshaded: the texture itself
+  const Simulator sim_full(config);
+  config.render.target_ambient = 0.45;
+  const Simulator sim_shaded(config);
+  const Renderer full(sim_full), shaded(sim_shaded);
+  const int64_t utime = sim_full.camera_utime(100);
+  const RenderedView a = full.render(utime).at(0), b = shaded.render(utime).at(0);
+  REQUIRE(a.visible);
+  // Off the anti-aliased outline, whose pixels on both sides blend target and room.
+  cv::Mat inside, near;
+  cv::erode(a.mask, inside, cv::Mat());
+  cv::dilate(a.mask, near, cv::Mat());
+  int pixels = 0, out_of_range = 0, room_differs = 0;
+  for (int y = 0; y < a.image.rows; ++y) {
+    for (int x = 0; x < a.image.cols; ++x) {
+      const int lit = a.image.at<uint8_t>(y, x), dim = b.image.at<uint8_t>(y, x);
+      if (near.at<uint8_t>(y, x) == 0) {
+        room_differs += lit != dim ? 1 : 0;
+      } else if (inside.at<uint8_t>(y, x) != 0) {
+        ++pixels;
+        // shade = ambient + (1 - ambient) Lambert, in [0.45, 1]; ±1 rounding
+        out_of_range += (dim > lit + 1 || dim < 0.45 * lit - 1) ? 1 : 0;
+      }
+    }
+  }
+  INFO(pixels << " target pixels, " << out_of_range << " outside [0.45, 1] of the unshaded value");
+  CHECK(pixels > 1000);
+  CHECK(out_of_range == 0);
+  CHECK(room_differs == 0);
+  CHECK(cv::countNonZero(a.mask != b.mask) == 0);
+}
+
 TEST_CASE("renderer: a scene with features everywhere the cameras look (no blank areas)") {
   // Every 32 x 32 px cell of the image, apart from those the target covers,
   // has texture: grey-level standard deviation above the noise alone.
@@ -360,6 +396,7 @@ TEST_CASE("renderer: bad render settings are refused with the key named") {
   CHECK_THAT(render_error_of("  noise_sigma: -1\n"), Catch::Contains("render.noise_sigma"));
   CHECK_THAT(render_error_of("  noise_sigma: .nan\n"), Catch::Contains("render.noise_sigma"));
   CHECK_THAT(render_error_of("  exposure_amplitude: 5\n"), Catch::Contains("render.exposure_amplitude"));
+  CHECK_THAT(render_error_of("  target_ambient: 1.5\n"), Catch::Contains("render.target_ambient"));
   CHECK_THAT(render_error_of("  scene_texture: bricks\n"),
              Catch::Contains("render.scene_texture") && Catch::Contains("bricks"));
   CHECK_THAT(render_error_of("  noise: 2\n"), Catch::Contains("render.noise") && Catch::Contains("unknown"));
