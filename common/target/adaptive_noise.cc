@@ -67,6 +67,7 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
   frame_chi2_ = 0.0;
   frame_dof_ = 0;
   inflation_ = 0.0;
+  inflation_time_ = 0.0;
   time_ += f.dt;
   const double frame_nis = f.dof > 0 ? f.chi2 / f.dof : 0.0;
   if (f.dof > 0 && f.chi2 > options_.nis_max * estimator::chi2_quantile(0.99, f.dof)) {
@@ -79,6 +80,7 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
     const double old_sigma = sigma_;
     sigma_ = std::min(options_.sigma_max, sigma_ * std::sqrt(std::min(frame_nis, options_.max_step)));
     inflation_ = (sigma_ * sigma_ - old_sigma * old_sigma) * tau;
+    inflation_time_ = tau;
     return;
   }
   window_.push_back(f);
@@ -119,6 +121,7 @@ void AdaptiveNoise::save(estimator::CheckpointWriter* out) const {
   out->put(consistent_);
   out->put(violations_);
   out->put(inflation_);
+  out->put(inflation_time_);
 }
 
 bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
@@ -143,6 +146,7 @@ bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
   a.consistent_ = in->take<bool>();
   a.violations_ = in->take<int64_t>();
   a.inflation_ = in->take<double>();
+  a.inflation_time_ = in->take<double>();
   if (!in->ok() || !(a.sigma_ > 0.0)) return false;
   *this = std::move(a);
   return true;

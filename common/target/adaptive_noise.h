@@ -19,8 +19,10 @@
 // gate rejects the target's measurements no update carries the matching
 // signal, so the innovations must — and the driven components' variance
 // gets what the new σ would have added over the time the rejected one was
-// used, (σ_new² − σ_old²) τ (inflation(): the filter's P of the target
-// was computed with a σ now judged wrong). The model is judged consistent (tight
+// used: a density √(σ_new² − σ_old²) over τ (inflation(), inflation_time():
+// the filter's P of the target was computed with a σ now judged wrong, and
+// TargetFilter propagates that noise through the target's motion, so its pose
+// gets the share it integrated too). The model is judged consistent (tight
 // coupling allowed) once `window` frames have passed without a violation and
 // the windowed NIS is at most nis_max.
 //
@@ -73,9 +75,10 @@ class AdaptiveNoise {
   bool consistent() const { return consistent_; }
   double window_nis() const;
   int64_t violations() const { return violations_; }
-  /// Variance to add to each driven component after the last frame (0
-  /// unless it violated the model).
+  /// Variance to add to each driven component after the last frame,
+  /// (σ_new² − σ_old²) τ (0 unless it violated the model), and τ.
   double inflation() const { return inflation_; }
+  double inflation_time() const { return inflation_time_; }
 
   /// Its whole memory into a checkpoint (target_checkpoint.h), and back
   /// (false if the bytes are not one).
@@ -104,6 +107,7 @@ class AdaptiveNoise {
   bool consistent_{false};
   int64_t violations_{0};
   double inflation_{0.0};
+  double inflation_time_{0.0};
 };
 
 }  // namespace target

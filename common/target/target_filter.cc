@@ -228,10 +228,14 @@ void TargetFilter::end_adaptive_frame(State& state) {
     adaptive_->end_frame(predicted_->x, predicted_->P, now.x, now.P, predicted_->dt);
   }
   if (adaptive_->inflation() > 0.0) {
-    // Process noise the rejected σ left out (adaptive_noise.h).
-    Matrix12d Q = Matrix12d::Zero();
-    for (const int j : driven_components()) Q(j, j) = adaptive_->inflation();
-    StateHelper::propagate(state, {target_}, Matrix12d::Identity(), Q);
+    // Process noise the rejected σ left out (adaptive_noise.h), through the
+    // target's motion over the time it was used: the pose integrated it too.
+    const double tau = adaptive_->inflation_time();
+    const estimator::ImuValue imu = state.imu()->get();
+    const TargetStep missed =
+        propagate_target(options_.representation, target_->get(), imu, imu, Matrix15d::Identity(),
+                         Matrix15d::Zero(), tau, options_.noise(std::sqrt(adaptive_->inflation() / tau)));
+    StateHelper::propagate(state, {target_}, Matrix12d::Identity(), missed.Q_TT);
   }
   predicted_.reset();
   noise_ = options_.noise(adaptive_->sigma());
