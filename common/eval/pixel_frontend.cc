@@ -15,9 +15,15 @@ CameraFrame PixelFrontEnd::frame(int64_t utime) {
   views_ = renderer_.render(utime);
   const std::vector<sim::RenderedView>& views = views_;
   boxes_.clear();
-  if (chain_) {
-    for (std::size_t cam = 0; cam < views.size(); ++cam) {
+  // The mask the node pairs with each image under target.use_mask:
+  // TARGET_MASK_TRUTH (the view's) or the segmenter's TARGET_MASK.
+  std::vector<cv::Mat> masks;
+  for (std::size_t cam = 0; cam < views.size(); ++cam) {
+    if (chain_) {
       boxes_.push_back(chain_->process(static_cast<int>(cam), utime, views[cam].image, views[cam].mask));
+      masks.push_back(chain_->last_mask().clone());  // last_mask() is the chain's own buffer
+    } else {
+      masks.push_back(views[cam].mask);
     }
   }
   // Truth: a box only where the target is visible (the feature tracker node
@@ -34,8 +40,9 @@ CameraFrame PixelFrontEnd::frame(int64_t utime) {
     if (!b) return std::nullopt;
     return frontend::Box{(*b)(0), (*b)(1), (*b)(2), (*b)(3)};
   };
-  const cv::Mat right = views.size() > 1 ? views[1].image : cv::Mat();
-  return tracker_.track(utime, views[0].image, right, box_of(0), box_of(1));
+  const bool stereo = views.size() > 1;
+  return tracker_.track(utime, views[0].image, stereo ? views[1].image : cv::Mat(), box_of(0), box_of(1), masks[0],
+                        stereo ? masks[1] : cv::Mat());
 }
 
 }  // namespace eval

@@ -8,7 +8,9 @@
 // With a BoxChain (common/segmentation/box_chain.h) the box comes instead
 // from the segmenter and the mask filter, as `vimot-segmenter` →
 // `vimot-mask-filter` → `vimot-feature-tracker` (TARGET_BOX) over LCM: no
-// ground truth in the chain (backend onnx).
+// ground truth in the chain (backend onnx). With tracker.target.use_mask the
+// tracker gets the view's true mask (TARGET_MASK_TRUTH) or the segmenter's
+// (TARGET_MASK), as the node pairs them.
 
 #include <cstdint>
 #include <optional>

@@ -44,6 +44,15 @@ void check_box(const std::optional<Box>& box, const std::string& name) {
   }
 }
 
+void check_mask(const cv::Mat& mask, const cv::Mat& image, const std::string& name) {
+  if (mask.empty()) return;
+  if (mask.type() != CV_8UC1 || mask.size() != image.size()) {
+    throw std::invalid_argument("FeatureTracker: " + name + " mask must be 8-bit (CV_8UC1) of the image's size " +
+                                size_text(image) + ", got " + size_text(mask) + " type " +
+                                std::to_string(mask.type()));
+  }
+}
+
 }  // namespace
 
 FeatureTracker::FeatureTracker(const FeatureTrackerOptions& options, const std::vector<CameraCalibration>& cameras)
@@ -60,10 +69,12 @@ FeatureTracker::FeatureTracker(const FeatureTrackerOptions& options, const std::
   static_.resize(n);
   target_.resize(n);
   prev_box_.resize(n);
+  eroded_mask_.resize(n);
 }
 
 void FeatureTracker::check_input(int64_t utime, const cv::Mat& left, const cv::Mat& right,
-                                 const std::optional<Box>& box_left, const std::optional<Box>& box_right) const {
+                                 const std::optional<Box>& box_left, const std::optional<Box>& box_right,
+                                 const cv::Mat& mask_left, const cv::Mat& mask_right) const {
   if (frame_index_ > 0 && utime <= last_utime_) {
     throw std::invalid_argument("FeatureTracker: utime " + std::to_string(utime) + " is not after the previous " +
                                 std::to_string(last_utime_));
@@ -75,9 +86,13 @@ void FeatureTracker::check_input(int64_t utime, const cv::Mat& left, const cv::M
     throw std::invalid_argument("FeatureTracker: a right image was given to a mono tracker");
   } else if (box_right) {
     throw std::invalid_argument("FeatureTracker: a right box was given to a mono tracker");
+  } else if (!mask_right.empty()) {
+    throw std::invalid_argument("FeatureTracker: a right mask was given to a mono tracker");
   }
   check_box(box_left, "left");
   check_box(box_right, "right");
+  check_mask(mask_left, left, "left");
+  check_mask(mask_right, right, "right");
 }
 
 double FeatureTracker::focal(int cam_a, int cam_b) const {
@@ -279,7 +294,7 @@ std::vector<FeatureTracker::TargetPoint> FeatureTracker::klt_target(int cam, con
     from.push_back(t.point);
     prev_of.emplace(t.point.id, &t);
   }
-  const PixelTest keep = [&](const cv::Point2f& px) { return in_box(cam, px, box); };
+  const PixelTest keep = [&](const cv::Point2f& px) { return on_target(cam, px, box); };
   std::vector<Point> tracked = klt(prev_pyramid_[c], cam, pyramid_[c], from, shift, keep);
   if (options_.target.anchor_align) align_to_anchors(cam, keep, &tracked);
   std::vector<Eigen::Vector2d> a, b;
@@ -298,8 +313,13 @@ std::vector<FeatureTracker::TargetPoint> FeatureTracker::klt_target(int cam, con
   return kept;
 }
 
-bool FeatureTracker::in_box(int cam, const cv::Point2f& px, const Box& box) const {
-  return box.contains(px.x, px.y) && cameras_[static_cast<std::size_t>(cam)].in_image(Eigen::Vector2d(px.x, px.y), 0.0);
+bool FeatureTracker::on_target(int cam, const cv::Point2f& px, const Box& box) const {
+  const auto c = static_cast<std::size_t>(cam);
+  if (!box.contains(px.x, px.y) || !cameras_[c].in_image(Eigen::Vector2d(px.x, px.y), 0.0)) return false;
+  const cv::Mat& mask = eroded_mask_[c];
+  if (mask.empty()) return true;
+  const cv::Point at(cvRound(px.x), cvRound(px.y));
+  return at.inside(cv::Rect(0, 0, mask.cols, mask.rows)) && mask.at<uint8_t>(at) != 0;
 }
 
 void FeatureTracker::match_target_stereo_klt(const Box& box_right, std::vector<std::vector<TargetPoint>>* cur) {
@@ -318,7 +338,7 @@ void FeatureTracker::match_target_stereo_klt(const Box& box_right, std::vector<s
   // points (<= num_features), and a target point lost on the right by the
   // target's own occlusion comes back when it turns.
   const std::vector<Point> found = klt(pyramid_[0], 1, pyramid_[1], lone, {},
-                                       [&](const cv::Point2f& px) { return in_box(1, px, box_right); });
+                                       [&](const cv::Point2f& px) { return on_target(1, px, box_right); });
   for (const Point& p : found) {
     TargetPoint t;
     t.point = p;
@@ -359,10 +379,10 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
     const int cell_capacity = (o.num_features + o.grid * o.grid - 1) / (o.grid * o.grid);
     std::vector<int> in_cell(static_cast<std::size_t>(o.grid * o.grid), 0);
     for (const TargetPoint& t : cur[c]) ++in_cell[static_cast<std::size_t>(cell_of(t.point.pixel))];
-    for (const OrbFeature& f : orb_.detect(images[c], box)) {
+    for (const OrbFeature& f : orb_.detect(images[c], box, eroded_mask_[c])) {
       if (cur[c].size() >= static_cast<std::size_t>(o.num_features)) break;
       int& cell_count = in_cell[static_cast<std::size_t>(cell_of(f.pixel))];
-      if (cell_count >= cell_capacity) continue;
+      if (cell_count >= cell_capacity || !on_target(cam, f.pixel, box)) continue;
       const bool near_tracked = std::any_of(cur[c].begin(), cur[c].begin() + static_cast<std::ptrdiff_t>(tracked),
                                             [&](const TargetPoint& t) {
                                               const cv::Point2f d = t.point.pixel - f.pixel;
@@ -495,8 +515,8 @@ void FeatureTracker::track_target(const std::vector<cv::Mat>& images, const std:
 }
 
 CameraFrame FeatureTracker::track(int64_t utime, const cv::Mat& left, const cv::Mat& right, std::optional<Box> box_left,
-                                  std::optional<Box> box_right) {
-  check_input(utime, left, right, box_left, box_right);
+                                  std::optional<Box> box_right, const cv::Mat& mask_left, const cv::Mat& mask_right) {
+  check_input(utime, left, right, box_left, box_right, mask_left, mask_right);
   using Clock = std::chrono::steady_clock;
   Clock::time_point t = Clock::now();
   const Clock::time_point start = t;
@@ -520,7 +540,16 @@ CameraFrame FeatureTracker::track(int64_t utime, const cv::Mat& left, const cv::
   const std::vector<std::optional<Box>> boxes =
       n == 2 ? std::vector<std::optional<Box>>{box_left, box_right} : std::vector<std::optional<Box>>{box_left};
   const StaticTrackOptions& o = options_.static_tracks;
+  const std::vector<cv::Mat> masks =
+      n == 2 ? std::vector<cv::Mat>{mask_left, mask_right} : std::vector<cv::Mat>{mask_left};
   for (std::size_t c = 0; c < n; ++c) {
+    eroded_mask_[c] = cv::Mat();
+    if (options_.target.use_mask && !masks[c].empty()) {
+      // Outside the image counts as off the target (border value 0).
+      const int r = o.target_mask_erode_px();
+      const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1));
+      cv::erode(masks[c] != 0, eroded_mask_[c], square, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    }
     pyramid_[c].clear();
     cv::buildOpticalFlowPyramid(images[c], pyramid_[c], cv::Size(o.klt_window_px, o.klt_window_px),
                                 o.klt_pyramid_levels);

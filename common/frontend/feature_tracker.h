@@ -58,12 +58,15 @@ class FeatureTracker {
   /// Tracks one (stereo) frame. `left` / `right`: 8-bit grey images of the
   /// calibrated size (`right` empty for mono). Boxes: the target in each
   /// image, [x_min, y_min, width, height] raw pixels; without a box every
-  /// feature of that image is static. Throws std::invalid_argument (the
-  /// tracker unchanged) for a wrong image size or type, a missing or
-  /// superfluous right image, a non-finite or negative box, or a utime not
-  /// after the previous frame's.
+  /// feature of that image is static. Masks (target.use_mask; ignored
+  /// otherwise): each image's target mask, 8-bit of the image's size,
+  /// nonzero = target; empty = none. Throws std::invalid_argument (the
+  /// tracker unchanged) for a wrong image or mask size or type, a missing or
+  /// superfluous right image, a right box or mask given to a mono tracker, a
+  /// non-finite or negative box, or a utime not after the previous frame's.
   CameraFrame track(int64_t utime, const cv::Mat& left, const cv::Mat& right, std::optional<Box> box_left,
-                    std::optional<Box> box_right);
+                    std::optional<Box> box_right, const cv::Mat& mask_left = cv::Mat(),
+                    const cv::Mat& mask_right = cv::Mat());
 
   int num_cameras() const { return static_cast<int>(cameras_.size()); }
   /// Target tracks that got an old id back by descriptor (loop closures).
@@ -88,7 +91,7 @@ class FeatureTracker {
   using PixelTest = std::function<bool(const cv::Point2f&)>;
 
   void check_input(int64_t utime, const cv::Mat& left, const cv::Mat& right, const std::optional<Box>& box_left,
-                   const std::optional<Box>& box_right) const;
+                   const std::optional<Box>& box_right, const cv::Mat& mask_left, const cv::Mat& mask_right) const;
   bool normalize(int cam, Point* p) const;
   bool usable(int cam, const cv::Point2f& px, const std::optional<Box>& box) const;
   void track_static_temporal(int cam, const std::optional<Box>& box);
@@ -114,8 +117,9 @@ class FeatureTracker {
   /// Keep flags for `right`: false for a point whose left partner (same id)
   /// RANSAC rejects as a stereo pair.
   std::vector<bool> stereo_inliers(const std::vector<Point>& left, const std::vector<Point>& right);
-  /// Inside `box` and camera `cam`'s image.
-  bool in_box(int cam, const cv::Point2f& px, const Box& box) const;
+  /// Inside `box` and camera `cam`'s image, and on its eroded target mask
+  /// if it has one.
+  bool on_target(int cam, const cv::Point2f& px, const Box& box) const;
   /// KLT from one pyramid to another, the guess shifted by `shift`; keeps
   /// points that converge where `keep` says, with an undistortable pixel.
   std::vector<Point> klt(const std::vector<cv::Mat>& from_pyr, int to_cam, const std::vector<cv::Mat>& to_pyr,
@@ -140,6 +144,9 @@ class FeatureTracker {
   std::vector<std::vector<Point>> static_;
   std::vector<std::vector<TargetPoint>> target_;
   std::vector<std::optional<Box>> prev_box_;
+  // Per camera, this frame's target mask eroded (target.use_mask); empty:
+  // none.
+  std::vector<cv::Mat> eroded_mask_;
 };
 
 }  // namespace vimot::frontend

@@ -26,7 +26,7 @@ OrbBoxDetector::OrbBoxDetector(const TargetTrackOptions& o)
   patch_radius_ = static_cast<int>(std::ceil(31.0 * std::pow(o.orb_scale_factor, o.orb_levels - 1)));
 }
 
-std::vector<OrbFeature> OrbBoxDetector::detect(const cv::Mat& image, const Box& box) const {
+std::vector<OrbFeature> OrbBoxDetector::detect(const cv::Mat& image, const Box& box, const cv::Mat& allowed) const {
   const cv::Rect image_rect(0, 0, image.cols, image.rows);
   const cv::Rect box_rect(static_cast<int>(std::floor(box.x_min)), static_cast<int>(std::floor(box.y_min)),
                           static_cast<int>(std::ceil(box.width)) + 1, static_cast<int>(std::ceil(box.height)) + 1);
@@ -36,7 +36,12 @@ std::vector<OrbFeature> OrbBoxDetector::detect(const cv::Mat& image, const Box& 
                                 inner.height + 2 * patch_radius_) &
                        image_rect;
   cv::Mat mask(roi.size(), CV_8UC1, cv::Scalar(0));
-  mask(cv::Rect(inner.x - roi.x, inner.y - roi.y, inner.width, inner.height)).setTo(255);
+  const cv::Rect inner_in_roi(inner.x - roi.x, inner.y - roi.y, inner.width, inner.height);
+  if (allowed.empty()) {
+    mask(inner_in_roi).setTo(255);
+  } else {
+    allowed(inner).copyTo(mask(inner_in_roi));
+  }
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
   orb_->detectAndCompute(image(roi), mask, kps, desc);

@@ -35,8 +35,10 @@ class OrbBoxDetector {
   /// At most options.num_features · grid² ORB features of an 8-bit grey
   /// image whose keypoints lie inside `box` (clipped to the image),
   /// strongest first; descriptors may use pixels around the box. Empty if
-  /// the box misses the image.
-  std::vector<OrbFeature> detect(const cv::Mat& image, const Box& box) const;
+  /// the box misses the image. `allowed` (8-bit of the image's size, if
+  /// given): keypoints only where it is nonzero, so the candidates are not
+  /// spent on corners the caller would drop.
+  std::vector<OrbFeature> detect(const cv::Mat& image, const Box& box, const cv::Mat& allowed = cv::Mat()) const;
 
  private:
   cv::Ptr<cv::ORB> orb_;

@@ -93,7 +93,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   only_keys(cfg, s + "target",
             {"num_features", "orb_fast_threshold", "orb_levels", "orb_scale_factor", "max_hamming", "match_ratio",
              "max_motion_px", "loop_closure_max_hamming", "max_stored_points", "frame_to_frame", "min_distance_px",
-             "stereo", "anchor_align", "grid"});
+             "stereo", "anchor_align", "grid", "use_mask"});
   only_keys(cfg, s + "ransac", {"threshold_px", "confidence", "max_iterations", "min_points", "seed"});
 
   StaticTrackOptions& st = o.static_tracks;
@@ -129,6 +129,7 @@ FeatureTrackerOptions FeatureTrackerOptions::from_config(const Config& cfg, cons
   read(cfg, s + "target.stereo", &t.stereo);
   read(cfg, s + "target.anchor_align", &t.anchor_align);
   read(cfg, s + "target.grid", &t.grid);
+  read(cfg, s + "target.use_mask", &t.use_mask);
 
   RansacOptions& r = o.ransac;
   read(cfg, s + "ransac.threshold_px", &r.threshold_px);

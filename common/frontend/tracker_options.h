@@ -8,7 +8,7 @@
 //   target:  num_features, orb_fast_threshold, orb_levels, orb_scale_factor,
 //            max_hamming, match_ratio, max_motion_px, loop_closure_max_hamming,
 //            max_stored_points, frame_to_frame, min_distance_px, stereo,
-//            anchor_align
+//            anchor_align, grid, use_mask
 //   ransac:  threshold_px, confidence, max_iterations, min_points, seed
 // Every key is optional; an unknown key is an error naming it. Meanings and
 // defaults: docs/feature_tracker.md.
@@ -53,6 +53,11 @@ struct StaticTrackOptions {
   /// Static features keep this far (px) from the target box: a KLT window
   /// overlapping the target follows the target's motion, not the room's.
   int box_margin_px() const { return klt_window_px / 2; }
+  /// target.use_mask erodes the target mask by this (px): a point's KLT
+  /// window reaches klt_window_px / 2 px either side of a sub-pixel
+  /// position, and its bilinear samples one pixel further from the rounded
+  /// one, so half the window rounded up keeps the whole window on the target.
+  int target_mask_erode_px() const { return (klt_window_px + 1) / 2; }
   void validate() const;
 };
 
@@ -96,6 +101,12 @@ struct TargetTrackOptions {
   // shaded faces of the same object get none; points on one face only are
   // a planar structure the monocular object tracker cannot resolve.
   int grid{1};
+  // Target points detected and kept only where the target mask given to
+  // FeatureTracker::track, eroded by static target_mask_erode_px(), is set:
+  // a point whose KLT / anchor window holds the background behind the
+  // silhouette follows neither the target nor the background. Without a
+  // mask for an image the box alone bounds its target points.
+  bool use_mask{false};
   void validate() const;
 };
 

@@ -67,6 +67,8 @@ SimPipeline::SimPipeline(sim::Simulator& sim, EstimatorInputs estimator,
       s,
       [this](int camera_id, int64_t utime, const cv::Mat& mask) {
         const mask_t msg = to_lcm_mask(mask, utime, camera_id);
+        // TARGET_MASK goes to the feature tracker (target.use_mask) and the mask filter.
+        tracker_->on_mask(msg.camera_id, msg.utime, mask_from_lcm(msg));
         mask_filter_->on_mask(msg.camera_id, msg.utime, msg.width, msg.height, msg.size, msg.data);
       },
       fail_on_error("segmenter"));
@@ -91,7 +93,9 @@ void SimPipeline::camera_frame(const CameraFrame& simulated) {
         segmenter_->on_image(view.camera_id, view.utime, image);
       }
     } else {
-      // TARGET_BOX_TRUTH: a perfect detection when the target is visible.
+      // TARGET_MASK_TRUTH (target.use_mask), then TARGET_BOX_TRUTH: a
+      // perfect detection when the target is visible.
+      tracker_->on_mask(view.camera_id, view.utime, mask_from_lcm(to_lcm_mask(view.mask, view.utime, view.camera_id)));
       tracker_->on_box(view.camera_id, view.utime, view.visible ? box_from(view.box) : std::nullopt);
     }
   }

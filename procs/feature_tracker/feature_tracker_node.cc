@@ -9,8 +9,8 @@
 namespace vimot {
 
 namespace {
-// Boxes kept per camera: enough for a box arriving a few frames ahead.
-constexpr std::size_t kMaxStoredBoxes = 16;
+// Boxes and masks kept per camera: enough for one arriving a few frames ahead.
+constexpr std::size_t kMaxStored = 16;
 }  // namespace
 
 FeatureTrackerNodeOptions FeatureTrackerNodeOptions::from_config(const Config& cfg) {
@@ -51,7 +51,9 @@ FeatureTrackerNode::FeatureTrackerNode(const FeatureTrackerNodeOptions& options,
     : options_(options),
       tracker_(options.tracker, options.cameras),
       on_frame_(std::move(on_frame)),
-      on_event_(std::move(on_event)) {}
+      on_event_(std::move(on_event)),
+      boxes_(options.cameras.size(), ByUtime<std::optional<frontend::Box>>(kMaxStored)),
+      masks_(options.cameras.size(), ByUtime<cv::Mat>(kMaxStored)) {}
 
 void FeatureTrackerNode::drop(const std::string& why) {
   ++images_dropped_;
@@ -63,31 +65,47 @@ void FeatureTrackerNode::error(const std::string& what) {
   if (on_event_) on_event_({NodeEvent::Kind::kError, what});
 }
 
+bool FeatureTrackerNode::known_camera(int camera_id, const std::string& what) {
+  if (camera_id >= 0 && camera_id < static_cast<int>(options_.cameras.size())) return true;
+  error(what + " for camera " + std::to_string(camera_id) + ", the tracker has " +
+        std::to_string(options_.cameras.size()));
+  return false;
+}
+
 void FeatureTrackerNode::on_box(int camera_id, int64_t utime, std::optional<frontend::Box> box) {
-  if (camera_id < 0 || camera_id >= static_cast<int>(options_.cameras.size())) {
-    error("target box for camera " + std::to_string(camera_id) + ", the tracker has " +
-          std::to_string(options_.cameras.size()));
-    return;
-  }
+  if (!known_camera(camera_id, "target box")) return;
   if (box && !(std::isfinite(box->x_min) && std::isfinite(box->y_min) && std::isfinite(box->width) &&
                std::isfinite(box->height) && box->width >= 0.0 && box->height >= 0.0)) {
     error("target box of camera " + std::to_string(camera_id) + " at utime " + std::to_string(utime) +
           " is not finite or has a negative size: taken as no box");
     box.reset();
   }
-  auto& boxes = boxes_[camera_id];
-  boxes[utime] = box;
-  while (boxes.size() > kMaxStoredBoxes) boxes.erase(boxes.begin());
+  boxes_[static_cast<std::size_t>(camera_id)].put(utime, box);
+  release_ready();
+}
+
+void FeatureTrackerNode::on_mask(int camera_id, int64_t utime, const cv::Mat& mask) {
+  if (!uses_mask() || !known_camera(camera_id, "target mask")) return;
+  const CameraCalibration& c = options_.cameras[static_cast<std::size_t>(camera_id)];
+  cv::Mat usable = mask;
+  if (mask.type() != CV_8UC1 || mask.cols != c.width || mask.rows != c.height) {
+    error("target mask of camera " + std::to_string(camera_id) + " at utime " + std::to_string(utime) + " is " +
+          std::to_string(mask.cols) + "x" + std::to_string(mask.rows) + " type " + std::to_string(mask.type()) +
+          ", expected 8-bit " + std::to_string(c.width) + "x" + std::to_string(c.height) + ": taken as no mask");
+    usable = cv::Mat();
+  }
+  masks_[static_cast<std::size_t>(camera_id)].put(utime, usable);
   release_ready();
 }
 
 std::optional<frontend::Box> FeatureTrackerNode::box_for(int camera_id, int64_t utime) const {
-  const auto& boxes = boxes_[camera_id];
-  auto it = boxes.upper_bound(utime);
-  if (it == boxes.begin()) return std::nullopt;
-  --it;
-  if (static_cast<double>(utime - it->first) > options_.box_max_age_s * 1e6) return std::nullopt;
-  return it->second;
+  const auto* box = boxes_[static_cast<std::size_t>(camera_id)].at(utime, options_.box_max_age_s * 1e6);
+  return box ? *box : std::nullopt;
+}
+
+cv::Mat FeatureTrackerNode::mask_for(int camera_id, int64_t utime) const {
+  const cv::Mat* mask = masks_[static_cast<std::size_t>(camera_id)].at(utime, options_.box_max_age_s * 1e6);
+  return mask ? *mask : cv::Mat();
 }
 
 void FeatureTrackerNode::on_image(int camera_id, int64_t utime, const cv::Mat& image) {
@@ -158,11 +176,13 @@ void FeatureTrackerNode::release_ready() {
   // A frame waits for its boxes; once box_wait_frames later frames are
   // complete too, the boxes of the earlier one are taken as missing (the
   // box source skipped it) so a silent box channel delays the output by
-  // that many frames, no more.
+  // that many frames, no more. Likewise the masks.
   while (!ready_.empty()) {
     const auto it = ready_.begin();
     bool boxes_in = true;
-    for (std::size_t c = 0; c < options_.cameras.size(); ++c) boxes_in = boxes_in && boxes_[c].count(it->first) != 0;
+    for (std::size_t c = 0; c < options_.cameras.size(); ++c) {
+      boxes_in = boxes_in && boxes_[c].has(it->first) && (!uses_mask() || masks_[c].has(it->first));
+    }
     if (!boxes_in && ready_.size() <= static_cast<std::size_t>(options_.box_wait_frames)) return;
     const auto [left, right] = it->second;
     const int64_t utime = it->first;
@@ -184,7 +204,8 @@ void FeatureTrackerNode::flush() {
 void FeatureTrackerNode::process(int64_t utime, const cv::Mat& left, const cv::Mat& right) {
   try {
     const CameraFrame frame =
-        tracker_.track(utime, left, right, box_for(0, utime), stereo() ? box_for(1, utime) : std::nullopt);
+        tracker_.track(utime, left, right, box_for(0, utime), stereo() ? box_for(1, utime) : std::nullopt,
+                       mask_for(0, utime), stereo() ? mask_for(1, utime) : cv::Mat());
     last_utime_ = utime;
     ++frames_tracked_;
     if (on_frame_) on_frame_(frame);

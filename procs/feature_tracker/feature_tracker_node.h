@@ -12,7 +12,8 @@
 // complete frame is held until every camera's box of its utime has arrived
 // (or a later frame is complete), so a box published after its images is
 // still used and a live run equals a replay; without it a box arriving after
-// its images is too late for them.
+// its images is too late for them. Masks (tracker.target.use_mask) are
+// paired and waited for as the boxes, by the same rules.
 
 #include <cstdint>
 #include <functional>
@@ -34,16 +35,41 @@ namespace vimot {
 
 class Config;
 
+/// One camera's messages by utime (target boxes, masks), the newest
+/// `capacity` kept.
+template <typename T>
+class ByUtime {
+ public:
+  explicit ByUtime(std::size_t capacity) : capacity_(capacity) {}
+  void put(int64_t utime, T value) {
+    items_[utime] = std::move(value);
+    while (items_.size() > capacity_) items_.erase(items_.begin());
+  }
+  bool has(int64_t utime) const { return items_.count(utime) != 0; }
+  /// The latest at or before `utime` and at most `max_age_us` older; null if none.
+  const T* at(int64_t utime, double max_age_us) const {
+    auto it = items_.upper_bound(utime);
+    if (it == items_.begin()) return nullptr;
+    --it;
+    return static_cast<double>(utime - it->first) > max_age_us ? nullptr : &it->second;
+  }
+
+ private:
+  std::size_t capacity_;
+  std::map<int64_t, T> items_;
+};
+
 struct FeatureTrackerNodeOptions {
   frontend::FeatureTrackerOptions tracker;
   /// cam0 (and cam1 for stereo).
   std::vector<CameraCalibration> cameras;
   /// Images held per camera while waiting for their partner.
   int max_pending_images{4};
-  /// A box older than this (s) than the image is not used.
+  /// A box (or mask) older than this (s) than the image is not used.
   double box_max_age_s{0.2};
   /// Hold each frame for its boxes (a box source runs: mask filter, the
-  /// simulator's truth box); false: track as soon as the images are there.
+  /// simulator's truth box), and its masks with tracker.target.use_mask;
+  /// false: track as soon as the images are there.
   bool wait_for_box{false};
   /// With wait_for_box: a frame goes out without its missing boxes once
   /// this many later frames are complete (>= 1; a slow box source such as
@@ -70,6 +96,10 @@ class FeatureTrackerNode {
   void on_image(int camera_id, int64_t utime, const cv::Mat& image);
   /// The target box of a camera at an image's utime; nullopt: no valid box.
   void on_box(int camera_id, int64_t utime, std::optional<frontend::Box> box);
+  /// The target mask of a camera at an image's utime (8-bit of the image's
+  /// size, nonzero = target); used with tracker.target.use_mask only.
+  void on_mask(int camera_id, int64_t utime, const cv::Mat& mask);
+  bool uses_mask() const { return options_.tracker.target.use_mask; }
   /// Tracks every frame still waiting for its boxes (end of input).
   void flush();
 
@@ -84,6 +114,8 @@ class FeatureTrackerNode {
   void release_ready();
   void process(int64_t utime, const cv::Mat& left, const cv::Mat& right);
   std::optional<frontend::Box> box_for(int camera_id, int64_t utime) const;
+  cv::Mat mask_for(int camera_id, int64_t utime) const;
+  bool known_camera(int camera_id, const std::string& what);
   void drop(const std::string& why);
   void error(const std::string& what);
 
@@ -92,7 +124,8 @@ class FeatureTrackerNode {
   FrameCallback on_frame_;
   EventCallback on_event_;
   std::map<int64_t, cv::Mat> pending_[2];
-  std::map<int64_t, std::optional<frontend::Box>> boxes_[2];
+  std::vector<ByUtime<std::optional<frontend::Box>>> boxes_;
+  std::vector<ByUtime<cv::Mat>> masks_;  // empty Mat: the camera's mask was unusable
   std::map<int64_t, std::pair<cv::Mat, cv::Mat>> ready_;  // complete frames waiting for boxes
   int64_t last_utime_{-1};
   int64_t frames_tracked_{0};

@@ -1,6 +1,7 @@
 // feature_tracker: the visual front end as an LCM process. Subscribes
-// CAM_LEFT / CAM_RIGHT (image_t; mono: CAM_LEFT only) and the target box
-// channel (target_box_t per camera), publishes FEATURES (features_t) at the
+// CAM_LEFT / CAM_RIGHT (image_t; mono: CAM_LEFT only), the target box
+// channel (target_box_t per camera) and, with tracker.target.use_mask, the
+// target mask channel (mask_t per camera), publishes FEATURES (features_t) at the
 // images' utime. All logic is in FeatureTrackerNode / common/frontend; this
 // file moves bytes.
 
@@ -12,6 +13,7 @@
 #include "common/process/process.h"
 #include "procs/feature_tracker/feature_tracker_node.h"
 #include "vimot/image_t.hpp"
+#include "vimot/mask_t.hpp"
 #include "vimot/target_box_t.hpp"
 
 namespace {
@@ -41,6 +43,11 @@ int run(int argc, const char* const* argv) {
   process.subscribe<vimot::target_box_t>(
       process.channel("target_box", "TARGET_BOX"),
       [&](const vimot::target_box_t& m) { node.on_box(m.camera_id, m.utime, vimot::box_of(m)); });
+  if (node.uses_mask()) {
+    process.subscribe<vimot::mask_t>(process.channel("target_mask", "TARGET_MASK"), [&](const vimot::mask_t& m) {
+      node.on_mask(m.camera_id, m.utime, vimot::mask_from_lcm(m));
+    });
+  }
   const int status = process.run();
   node.flush();
   vimot::log_info("tracked ", node.frames_tracked(), " frames, dropped ", node.images_dropped(), " images, ",

@@ -1,6 +1,7 @@
 // The feature tracker on rendered stereo pairs against the true
 // correspondences (common/eval/tracker_accuracy.h): the shipped rendered
-// configs (config/sim_paper.yaml, config/feature_tracker_sim.yaml), 3-6 s.
+// configs (config/sim_paper.yaml, config/feature_tracker_sim.yaml), 3-6 s;
+// the mono scenario with target.use_mask against its true mask.
 // The bounds are the noise model the estimator assumes (config/vins.yaml
 // sigma_px = 1 px per axis, white): the error norm is then Rayleigh, with
 // median 1.18 px, 95th percentile 2.45 px and P(> 3 px) = exp(-4.5) = 1.1 %.
@@ -240,4 +241,40 @@ TEST_CASE("summarise: median, nearest-rank p95 and the > 3 px fraction", "[eval]
   CHECK(s.p95_px == 19.0);
   CHECK(s.outlier_fraction == Approx(17.0 / 20.0));
   CHECK(eval::summarise({}).count == 0);
+}
+
+TEST_CASE("PixelFrontEnd with target.use_mask: each target point's window lies on the true mask",
+          "[eval][tracker_accuracy]") {
+  // The mono rendered scenario; the front end hands the tracker the view's
+  // true mask, as the node gets TARGET_MASK_TRUTH. Checked against that
+  // mask pixel by pixel: every pixel a 15 px KLT window around the point
+  // samples (±8 around its rounded pixel) is on the target.
+  sim::SimConfig c = sim::from_config(Config::load_file(kSource + "/config/sim_mono.yaml"));
+  c.duration = 1.5;
+  const sim::Simulator sim(c);
+  frontend::FeatureTrackerOptions options = frontend::FeatureTrackerOptions::from_config(
+      Config::load_file(kSource + "/config/feature_tracker_sim_mono.yaml"), "tracker");
+  options.target.use_mask = true;
+  REQUIRE(options.static_tracks.klt_window_px == 15);
+  eval::PixelFrontEnd front(sim, options);
+  int targets = 0, off = 0;
+  for (int64_t k = 0; k < sim.camera_frame_count(); ++k) {
+    const CameraFrame f = front.frame(sim.camera_utime(k));
+    const cv::Mat& mask = front.last_views().at(0).mask;
+    for (const FeatureObservation& o : f.observations) {
+      if (!o.is_target) continue;
+      ++targets;
+      const int u0 = static_cast<int>(std::lround(o.pixel.x())), v0 = static_cast<int>(std::lround(o.pixel.y()));
+      bool on = true;
+      for (int v = v0 - 8; v <= v0 + 8 && on; ++v) {
+        for (int u = u0 - 8; u <= u0 + 8 && on; ++u) {
+          on = u >= 0 && v >= 0 && u < mask.cols && v < mask.rows && mask.at<uint8_t>(v, u) != 0;
+        }
+      }
+      off += on ? 0 : 1;
+    }
+  }
+  INFO(targets << " target observations, " << off << " with a window off the true mask");
+  CHECK(targets > 100);
+  CHECK(off == 0);
 }

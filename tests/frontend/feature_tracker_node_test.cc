@@ -192,6 +192,43 @@ TEST_CASE("with box_wait_frames a frame waits that many later frames for boxes t
   CHECK(node.errors() == 0);
 }
 
+TEST_CASE("with target.use_mask a frame waits for its mask too, and its target points lie on the eroded mask") {
+  Recorder r;
+  FeatureTrackerNodeOptions o = options(1);
+  o.wait_for_box = true;
+  o.tracker.target.use_mask = true;
+  FeatureTrackerNode node = make_node(o, r);
+  REQUIRE(node.uses_mask());
+  const cv::Mat image = test::make_texture(320, 240, 55, 400);
+  const frontend::Box box{100.0, 60.0, 120.0, 100.0};
+  // The target: the box's left half (columns 100..159, rows 60..159).
+  cv::Mat mask = cv::Mat::zeros(240, 320, CV_8UC1);
+  mask(cv::Rect(100, 60, 60, 100)).setTo(255);
+  node.on_image(0, 100, image);
+  node.on_box(0, 100, box);
+  CHECK(r.frames.empty());  // its mask has not come
+  node.on_mask(0, 50, cv::Mat::zeros(240, 320, CV_8UC1));  // an earlier frame's: not this one's
+  CHECK(r.frames.empty());
+  node.on_mask(0, 100, mask);
+  REQUIRE(r.frames.size() == 1);
+  int targets = 0;
+  for (const FeatureObservation& f : r.frames[0].observations) {
+    if (!f.is_target) continue;
+    ++targets;
+    // The whole 15 px window (±7.5 px) on the mask's pixels (centres 100..159, 60..159).
+    CHECK(f.pixel.x() - 7.5 >= 99.5);
+    CHECK(f.pixel.x() + 7.5 <= 159.5);
+    CHECK(f.pixel.y() - 7.5 >= 59.5);
+    CHECK(f.pixel.y() + 7.5 <= 159.5);
+  }
+  CHECK(targets > 0);
+  node.on_mask(0, 200, cv::Mat::zeros(10, 10, CV_8UC1));
+  CHECK(node.errors() == 1);  // wrong size: taken as no mask, the frame not held for it
+  node.on_box(0, 200, box);
+  node.on_image(0, 200, image);
+  CHECK(r.frames.size() == 2);
+}
+
 TEST_CASE("FeatureTrackerNodeOptions reads config/feature_tracker.yaml and refuses unknown keys") {
   const Config cfg = Config::load_file(std::string(VIMOT_SOURCE_DIR) + "/config/feature_tracker.yaml");
   const FeatureTrackerNodeOptions o = FeatureTrackerNodeOptions::from_config(cfg);

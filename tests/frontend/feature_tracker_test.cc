@@ -249,6 +249,66 @@ TEST_CASE("target.grid spreads the target features over the box: a shaded half g
   CHECK(shaded2 >= 15);
 }
 
+TEST_CASE("target.use_mask: target points only where their KLT window lies wholly on the target mask") {
+  // A textured disc (the target) in a box that also holds the textured
+  // background around it; the disc moves between the frames.
+  const CameraCalibration cam = test::pinhole(640, 480, 400.0);
+  const cv::Mat background = test::make_texture(640, 480, 61, 1500);
+  const cv::Mat texture = test::make_texture(640, 480, 62, 1500);
+  constexpr int kRadius = 55;
+  constexpr int kMarginPx = 25;  // of background between the disc and the box
+  struct View {
+    cv::Mat image, mask;
+    Box box;
+    Eigen::Vector2d centre;
+  };
+  const auto view = [&](cv::Point c) {
+    View v;
+    v.mask = cv::Mat::zeros(480, 640, CV_8UC1);
+    cv::circle(v.mask, c, kRadius, cv::Scalar(255), cv::FILLED);
+    v.image = background.clone();
+    texture.copyTo(v.image, v.mask);
+    const int half = kRadius + kMarginPx;
+    v.box = Box{c.x - half + 0.0, c.y - half + 0.0, 2.0 * half, 2.0 * half};
+    v.centre = Eigen::Vector2d(c.x, c.y);
+    return v;
+  };
+  const View views[2] = {view({300, 220}), view({314, 228})};
+  // The truth: a point's window (klt_window_px = 15, ±7.5 px around it) on
+  // the disc, i.e. its four corners within the radius (+ 0.5: the disc's
+  // pixels are those whose centre is inside).
+  const auto window_on_disc = [&](const Eigen::Vector2d& px, const Eigen::Vector2d& centre) {
+    for (const double du : {-7.5, 7.5}) {
+      for (const double dv : {-7.5, 7.5}) {
+        if ((px + Eigen::Vector2d(du, dv) - centre).norm() > kRadius + 0.5) return false;
+      }
+    }
+    return true;
+  };
+  const auto run = [&](bool use_mask) {
+    FeatureTrackerOptions options;
+    options.target.frame_to_frame = "klt";
+    options.target.use_mask = use_mask;
+    FeatureTracker tracker(options, {cam});
+    std::pair<int, int> on_off{0, 0};  // target points with the window on / off the disc
+    for (int k = 0; k < 2; ++k) {
+      const View& v = views[k];
+      const CameraFrame f = tracker.track(k * 50000, v.image, cv::Mat(), v.box, std::nullopt, v.mask);
+      for (const auto& [id, px] : pixels_of(f, 0, true)) {
+        (window_on_disc(px, v.centre) ? on_off.first : on_off.second)++;
+      }
+    }
+    return on_off;
+  };
+  const auto [on_masked, off_masked] = run(true);
+  const auto [on_plain, off_plain] = run(false);
+  INFO("with the mask " << on_masked << " on, " << off_masked << " off the disc; without " << on_plain << " on, "
+                        << off_plain << " off");
+  CHECK(off_masked == 0);
+  CHECK(on_masked >= 20);
+  CHECK(off_plain >= 10);  // the box's background and the disc's rim hold target points without the mask
+}
+
 TEST_CASE("a target that leaves and comes back gets its old ids back (target loop closure)") {
   const CameraCalibration cam = test::pinhole(640, 480, 400.0);
   const cv::Mat background = test::make_texture(640, 480, 31, 1500);
@@ -311,6 +371,10 @@ TEST_CASE("the tracker rejects bad input with a message and stays usable") {
              Catch::Contains("not after"));
   FeatureTracker mono(FeatureTrackerOptions{}, {cam});
   CHECK_THAT(message([&] { mono.track(0, image, image, std::nullopt, std::nullopt); }), Catch::Contains("mono"));
+  CHECK_THAT(message([&] { mono.track(0, image, cv::Mat(), std::nullopt, std::nullopt, image(cv::Rect(0, 0, 9, 9))); }),
+             Catch::Contains("left mask") && Catch::Contains("640x480"));
+  CHECK_THAT(message([&] { mono.track(0, image, cv::Mat(), std::nullopt, std::nullopt, cv::Mat(), image); }),
+             Catch::Contains("right mask"));
   CHECK_THROWS_AS(FeatureTracker(FeatureTrackerOptions{}, {}), std::invalid_argument);
 }
 

@@ -77,4 +77,13 @@ TEST_CASE("tracker options: values are read, unknown keys and bad values refused
   // Both follow KLT tracks: with ORB re-detection there are none.
   CHECK_THAT(error_of("tracker:\n  target: {stereo: klt}\n"), Catch::Contains("frame_to_frame klt"));
   CHECK_THAT(error_of("tracker:\n  target: {anchor_align: true}\n"), Catch::Contains("frame_to_frame klt"));
+  CHECK(FeatureTrackerOptions::from_config(Config::from_string("tracker:\n  target: {use_mask: true}\n"), "tracker")
+            .target.use_mask);
+  CHECK_FALSE(FeatureTrackerOptions().target.use_mask);
+  CHECK_THAT(error_of("tracker:\n  target: {use_mask: 8}\n"), Catch::Contains("target.use_mask"));
+  CHECK_THAT(error_of("tracker:\n  target: {mask: true}\n"),
+             Catch::Contains("target.mask") && Catch::Contains("unknown"));
+  // Half the KLT window, rounded up: 15 -> 8, 11 -> 6.
+  CHECK(FeatureTrackerOptions().static_tracks.target_mask_erode_px() == 8);
+  CHECK(o.static_tracks.target_mask_erode_px() == 6);
 }
