@@ -23,7 +23,10 @@ int run_main(const char* program, int argc, char** argv, int (*run)(int, const c
   try {
     return run(argc, argv);
   } catch (const std::exception& e) {
-    std::cerr << program << ": " << e.what() << "\n";
+    // ArgParser's own errors already name the program.
+    const std::string prefix = std::string(program) + ": ";
+    const std::string what = e.what();
+    std::cerr << (what.compare(0, prefix.size(), prefix) == 0 ? "" : prefix) << what << "\n";
     return 1;
   }
 }

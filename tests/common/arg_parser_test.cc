@@ -1,11 +1,32 @@
 #include <catch2/catch.hpp>
 
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
 #include "common/process/arg_parser.h"
 
 using vimot::ArgError;
 using vimot::ArgParser;
 
 namespace {
+// What run_main prints to std::cerr and returns for a run that throws `error`.
+std::string run_main_message(int* status, void (*error)()) {
+  static void (*thrower)() = nullptr;
+  thrower = error;
+  std::ostringstream err;
+  std::streambuf* const saved = std::cerr.rdbuf(err.rdbuf());
+  char arg0[] = "vimot-test";
+  char* argv[] = {arg0, nullptr};
+  *status = vimot::run_main("vimot-test", 1, argv, [](int, const char* const*) -> int {
+    thrower();
+    return 0;
+  });
+  std::cerr.rdbuf(saved);
+  return err.str();
+}
+
 ArgParser make_parser() {
   ArgParser p("vimot-test", "A test program.");
   p.add_option("speed", "FACTOR", "playback speed", "1.0");
@@ -62,4 +83,17 @@ TEST_CASE("bad arguments name what was wrong") {
   CHECK(fails_with({"prog", "--seed", "4.2"}, "--seed must be an integer"));
   CHECK(fails_with({"prog", "a.lcm", "b.lcm"}, "expected 0 to 1 positional"));
   CHECK(fails_with({"prog", "--quiet=yes"}, "takes no value"));
+}
+
+TEST_CASE("run_main names the program once") {
+  int status = 0;
+  // ArgParser's errors carry the program's name already.
+  CHECK(run_main_message(&status, [] {
+          const char* argv[] = {"vimot-test", "--sped", nullptr};
+          make_parser().parse(2, argv);
+        }) == "vimot-test: unknown option '--sped' (see --help)\n");
+  CHECK(status == 1);
+  CHECK(run_main_message(&status, [] { throw std::runtime_error("--duration must be > 0"); }) ==
+        "vimot-test: --duration must be > 0\n");
+  CHECK(status == 1);
 }
