@@ -12,8 +12,9 @@
 // family (79 deg); with points on the shaded faces too (target.grid,
 // render.target_ambient; docs/feature_tracker.md, "Target points on every
 // face") a track starts on the right structure. Its unit still drifts by a
-// few per cent over 60 s (docs/scale_estimator.md, "From pixels"), which
-// the position case shows.
+// few per cent over 60 s, so its position (0.072 m RMS here) is above the
+// feature level's 0.05 m: a known gap, kept in docs/scale_estimator.md
+// ("From pixels") and docs/object_tracker.md ("Open issues"), not here.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -136,14 +137,4 @@ TEST_CASE("object tracker from rendered pixels: a track starts on the right stru
   CHECK(run.rotation_rms_deg < 5.0);
   CHECK(run.centre_ray_error_deg >= 0.0);
   CHECK(run.centre_ray_error_deg < 0.2);  // 1.6 px at f = 458 px
-}
-
-TEST_CASE("object tracker from rendered pixels: position as accurate as at feature level",
-          "[object_tracker][pixels][!shouldfail]") {
-  // The feature-level bound (object_tracker_test, seed 1, 1 px: 0.05 m).
-  // From pixels the tracker's unit drifts by 1-3 % within these 6 s
-  // (0.07 m RMS), 2-6 % over 60 s: docs/scale_estimator.md, "From pixels".
-  const PixelRun& run = pixel_run();
-  INFO("position RMS " << run.position_rms_m << " m (max " << run.position_max_m << ")");
-  CHECK(run.position_rms_m < 0.05);
 }
