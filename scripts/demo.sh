@@ -9,6 +9,8 @@
 #   scripts/demo.sh pixels-truthbox  the same with the simulator's true target
 #                          box instead of the network and the mask filter
 #   scripts/demo.sh mono-pixels  monocular metric scale from rendered images
+#   scripts/demo.sh mono-segmented  the same with no ground truth in the chain
+#                          (segmenter network, mask filter)
 # Installs what is missing, builds, starts the processes of a sheriff config
 # with vimot-sheriff and prints a summary: processes, messages per channel,
 # the accuracy of the LCM run against ground truth, the same scenario run
@@ -41,6 +43,9 @@
 #    LCM run against the same seed's offline runs from pixels
 #    (vimot-vio-eval --pixels, vimot-scale-eval --pixels); exits 4 if
 #    either differs.
+#  - mono-segmented: sheriff_configs/sim_mono_segmented.pmd (mono-pixels with
+#    the segmenter's network and the mask filter giving the target box and
+#    mask, no ground truth in the chain), compared likewise.
 #
 # Environment (all optional):
 #   VIMOT_SIM_CONFIG  scenario file in config/ (default sim_paper.yaml; mono:
@@ -50,11 +55,12 @@
 #                     adjustment takes ≈ 20 ms per frame; pixels: 0.25, the
 #                     network takes ≈ 70 ms per image; mono-pixels: 0.5, the
 #                     object tracker takes ≈ 13 ms per frame there,
-#                     docs/scale_estimator.md;
+#                     docs/scale_estimator.md; mono-segmented: 0.2, the
+#                     network at 20 images per simulated second;
 #                     on 2 cores at 4x UDP already loses IMU messages, which
 #                     the heartbeats count, and the demo then fails)
 #   VIMOT_SEED        noise seed (default 1)
-#   VIMOT_DURATION    pixels: seconds to simulate (default 30; mono-pixels 60,
+#   VIMOT_DURATION    pixels: seconds to simulate (default 30; mono-pixels and mono-segmented 60,
 #                     the scale estimator's 40 s window needs most of it; rendering and
 #                     tracking cost ≈ 25 ms per stereo frame, so the default
 #                     speed there is 1)
@@ -80,8 +86,9 @@ case "${1:-}" in
   pixels) pipeline=pixels ;;
   pixels-truthbox) pipeline=pixels-truthbox ;;
   mono-pixels) pipeline=mono_pixels ;;
+  mono-segmented) pipeline=mono_segmented ;;
   "") ;;
-  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels', 'pixels-truthbox', 'mono-pixels' or --help)" >&2; exit 1 ;;
+  *) echo "demo.sh: unknown argument '$1' (expected nothing, 'mono', 'pixels', 'pixels-truthbox', 'mono-pixels', 'mono-segmented' or --help)" >&2; exit 1 ;;
 esac
 
 "$here/scripts/build.sh"
@@ -115,6 +122,16 @@ elif [ $pipeline = mono_pixels ]; then
   export VIMOT_TRACKER_CONFIG=feature_tracker_sim_mono.yaml
   export VIMOT_DURATION="${VIMOT_DURATION:-60}"
   export VIMOT_SPEED="${VIMOT_SPEED:-0.5}"
+elif [ $pipeline = mono_segmented ]; then
+  pmd="$here/sheriff_configs/sim_mono_segmented.pmd"
+  export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_mono.yaml}"
+  export VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins_mono.yaml}"
+  # The configs sim_mono_segmented.pmd runs (the offline runs take them too).
+  export VIMOT_TRACKER_CONFIG=feature_tracker_segmented_mono.yaml
+  export VIMOT_SEGMENTER_CONFIG=segmenter_mono.yaml
+  export VIMOT_MASK_FILTER_CONFIG=mask_filter_mono.yaml
+  export VIMOT_DURATION="${VIMOT_DURATION:-60}"
+  export VIMOT_SPEED="${VIMOT_SPEED:-0.2}"
 else
   pmd="$here/sheriff_configs/sim_demo.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
@@ -155,10 +172,10 @@ echo "== VIO accuracy of the LCM run (VINS_STATE vs GROUND_TRUTH):"
 perturb_seed=$(sed -n 's/^ *perturb_seed: *\([0-9]*\).*/\1/p' "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" | head -n 1)
 # The same seed offline, in-process: the figures the LCM run must equal.
 offline_args=()
-if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ] || [ $pipeline = mono_pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = pixels-truthbox ] || [ $pipeline = mono_pixels ] || [ $pipeline = mono_segmented ]; then
   offline_args=(--duration "$VIMOT_DURATION" --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG")
 fi
-if [ $pipeline = pixels ]; then
+if [ $pipeline = pixels ] || [ $pipeline = mono_segmented ]; then
   offline_args+=(--segmenter "$VIMOT_CONFIG/$VIMOT_SEGMENTER_CONFIG" --mask-filter "$VIMOT_CONFIG/$VIMOT_MASK_FILTER_CONFIG")
 fi
 "$VIMOT_BIN/vimot-vio-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
@@ -200,13 +217,12 @@ if [ $pipeline = pixels ]; then
     --own-target-frame --box-channel TARGET_BOX > "$out/lcm_box.txt" 2>&1 || true
   grep -E '^(box|target kept)' "$out/lcm_box.txt" | sed 's/^/   /'
 fi
-if [ $pipeline = mono_pixels ]; then
+if [ $pipeline = mono_pixels ] || [ $pipeline = mono_segmented ]; then
   echo "== metric scale of the LCM run (SCALE_ESTIMATE, OBJECT_POSE_METRIC, OBJECT_STATE vs GROUND_TRUTH), and the offline run from pixels:"
   "$VIMOT_BIN/vimot-scale-eval" --sim-config "$VIMOT_CONFIG/$VIMOT_SIM_CONFIG" \
     --vins-config "$VIMOT_CONFIG/$VIMOT_VINS_CONFIG" --tracker-config "$VIMOT_CONFIG/object_tracker.yaml" \
     --scale-config "$VIMOT_CONFIG/scale_estimator.yaml" --runs 1 --first-seed "$VIMOT_SEED" \
-    --perturb-seed "${perturb_seed:-0}" --duration "$VIMOT_DURATION" \
-    --pixels "$VIMOT_CONFIG/$VIMOT_TRACKER_CONFIG" --out "$out/offline_scale" --quiet > "$out/offline_scale.txt" 2>&1 || true
+    --perturb-seed "${perturb_seed:-0}" "${offline_args[@]}" --out "$out/offline_scale" --quiet > "$out/offline_scale.txt" 2>&1 || true
   grep -E '^(seed|mean)' "$out/offline_scale.txt" | sed 's/^/   /' || true
   scale_status=0
   "$VIMOT_BIN/vimot-log-eval" "$VIMOT_LOG" --scale-truth "$out/offline_scale/summary.json" --tolerance 1e-6 \

@@ -197,14 +197,25 @@ TEST_CASE("a directory or an empty file as a process config says so", "[config]"
 
 // The config loader has no include: the segmented chain's tracker configs
 // copy the true-box ones' tracker settings, and must not drift from them
-// (the figures of the two chains are compared).
+// (the figures of the two chains are compared). One key may differ:
+// whether the target points are kept on the mask, which comes from the
+// network in one chain and is the truth in the other (measured apart,
+// docs/segmented_pipeline.md).
 TEST_CASE("the segmented tracker configs track as the true-box ones") {
+  // The tracker section's keys and values, comments left out.
   const auto tracker_section = [](const std::string& file) {
     std::ifstream in(source_path("config/" + file));
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::size_t at = text.find("\ntracker:\n");
-    REQUIRE(at != std::string::npos);
-    return text.substr(at);
+    std::string section;
+    bool in_tracker = false;
+    for (std::string line; std::getline(in, line);) {
+      if (line == "tracker:") in_tracker = true;
+      const std::size_t comment = line.find('#');
+      if (comment != std::string::npos) line.erase(comment);
+      line.erase(line.find_last_not_of(' ') + 1);
+      if (in_tracker && !line.empty() && line.find("use_mask:") == std::string::npos) section += line + "\n";
+    }
+    REQUIRE(!section.empty());
+    return section;
   };
   CHECK(tracker_section("feature_tracker_segmented.yaml") == tracker_section("feature_tracker_sim.yaml"));
   CHECK(tracker_section("feature_tracker_segmented_mono.yaml") == tracker_section("feature_tracker_sim_mono.yaml"));
