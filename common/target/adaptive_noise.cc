@@ -59,7 +59,45 @@ void AdaptiveNoise::end_frame(const Eigen::VectorXd& x_minus, const Eigen::Vecto
   finish(f, true);
 }
 
-void AdaptiveNoise::end_frame_innovations_only() { finish(Frame{}, false); }
+void AdaptiveNoise::end_frame_innovations_only(double dt) {
+  Frame f;
+  f.dt = std::max(dt, 0.0);
+  finish(f, false);
+}
+
+bool AdaptiveNoise::violates(double chi2, int dof) const {
+  return dof > 0 && chi2 > options_.nis_max * estimator::chi2_quantile(0.99, dof);
+}
+
+void AdaptiveNoise::violate(double nis, double dt) {
+  ++violations_;
+  // How long the rejected σ has been used: the window (its evidence) and
+  // this frame, counted once however many steps the frame takes.
+  if (frame_tau_ == 0.0) {
+    frame_tau_ = dt;
+    for (const Frame& w : window_) frame_tau_ += w.dt;
+  }
+  window_.clear();
+  frames_since_violation_ = 0;
+  consistent_ = false;
+  const double old_sigma = sigma_;
+  sigma_ = std::min(options_.sigma_max, sigma_ * std::sqrt(std::min(nis, options_.max_step)));
+  inflation_ = (sigma_ * sigma_ - old_sigma * old_sigma) * frame_tau_;
+  inflation_time_ = frame_tau_;
+}
+
+bool AdaptiveNoise::inflate_before_update(double chi2, int dof, double dt) {
+  inflation_ = 0.0;
+  inflation_time_ = 0.0;
+  // Once the frame violated, step on until its blocks are where the gate
+  // accepts them: stopping at the violation bound would leave them between
+  // it and the gate, rejected, and the target drifting without a violation.
+  const bool stepping = frame_tau_ > 0.0;
+  const bool step = stepping ? dof > 0 && chi2 > estimator::chi2_quantile(0.95, dof) : violates(chi2, dof);
+  if (!step || !(dt > 0.0) || sigma_ >= options_.sigma_max) return false;
+  violate(chi2 / dof, dt);
+  return true;
+}
 
 void AdaptiveNoise::finish(Frame f, bool has_matching) {
   f.chi2 = frame_chi2_;
@@ -69,20 +107,10 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
   inflation_ = 0.0;
   inflation_time_ = 0.0;
   time_ += f.dt;
-  const double frame_nis = f.dof > 0 ? f.chi2 / f.dof : 0.0;
-  if (f.dof > 0 && f.chi2 > options_.nis_max * estimator::chi2_quantile(0.99, f.dof)) {
-    ++violations_;
-    double tau = f.dt;  // how long the rejected σ has been used
-    for (const Frame& w : window_) tau += w.dt;
-    window_.clear();
-    frames_since_violation_ = 0;
-    consistent_ = false;
-    const double old_sigma = sigma_;
-    sigma_ = std::min(options_.sigma_max, sigma_ * std::sqrt(std::min(frame_nis, options_.max_step)));
-    inflation_ = (sigma_ * sigma_ - old_sigma * old_sigma) * tau;
-    inflation_time_ = tau;
-    return;
-  }
+  const bool violated = violates(f.chi2, f.dof);
+  if (violated) violate(f.chi2 / f.dof, f.dt);
+  frame_tau_ = 0.0;
+  if (violated) return;
   window_.push_back(f);
   while (static_cast<int>(window_.size()) > options_.window) window_.pop_front();
   ++frames_since_violation_;
@@ -122,6 +150,7 @@ void AdaptiveNoise::save(estimator::CheckpointWriter* out) const {
   out->put(violations_);
   out->put(inflation_);
   out->put(inflation_time_);
+  out->put(frame_tau_);
 }
 
 bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
@@ -147,6 +176,7 @@ bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
   a.violations_ = in->take<int64_t>();
   a.inflation_ = in->take<double>();
   a.inflation_time_ = in->take<double>();
+  a.frame_tau_ = in->take<double>();
   if (!in->ok() || !(a.sigma_ > 0.0)) return false;
   *this = std::move(a);
   return true;

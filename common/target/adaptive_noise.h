@@ -24,7 +24,10 @@
 // TargetFilter propagates that noise through the target's motion, so its pose
 // gets the share it integrated too). The model is judged consistent (tight
 // coupling allowed) once `window` frames have passed without a violation and
-// the windowed NIS is at most nis_max.
+// the windowed NIS is at most nis_max. A frame whose first blocks (the
+// in-state points) already violate takes its steps before its update
+// (inflate_before_update), so its measurements correct the target rather
+// than being gated out while σ is bracketed frame by frame.
 //
 // Hold: the σ used is the largest windowed estimate of the last hold_s
 // seconds. The matched σ̂ is the target's *mean* density; a manoeuvring
@@ -66,8 +69,18 @@ class AdaptiveNoise {
   /// update of the frame (diagonals). Updates sigma() and consistent().
   void end_frame(const Eigen::VectorXd& x_minus, const Eigen::VectorXd& P_minus, const Eigen::VectorXd& x_plus,
                  const Eigen::VectorXd& P_plus, double dt);
-  /// Ends a frame with no propagation to match (the target's first frame).
-  void end_frame_innovations_only();
+  /// Ends a frame with no propagation to match (the target's first frame,
+  /// or one inflated before its update: its P⁻ holds the inflation, not σ² dt),
+  /// dt long (0 for the first).
+  void end_frame_innovations_only(double dt = 0.0);
+  /// Before a frame's update: if the χ² of its blocks so far (dof, the frame
+  /// propagated over dt) violate the model, takes the violation's σ step now
+  /// and returns true; inflation() is then the variance to add before the
+  /// blocks are gated (their χ² computed again and passed in again), so the
+  /// frame's measurements correct the target instead of being rejected. Once
+  /// the frame violated it steps until χ² ≤ χ²_0.95(dof) (where the gate
+  /// accepts the blocks). False when done or at sigma_max.
+  bool inflate_before_update(double chi2, int dof, double dt);
 
   double sigma() const { return sigma_; }
   /// The latest windowed estimate (the mean density), before the hold.
@@ -94,6 +107,9 @@ class AdaptiveNoise {
     int dof{0};
   };
   void finish(Frame f, bool has_matching);
+  bool violates(double chi2, int dof) const;
+  /// The violation's bookkeeping and σ step (NIS of the violating blocks).
+  void violate(double nis, double dt);
 
   AdaptiveNoiseOptions options_;
   double sigma_;
@@ -108,6 +124,7 @@ class AdaptiveNoise {
   int64_t violations_{0};
   double inflation_{0.0};
   double inflation_time_{0.0};
+  double frame_tau_{0.0};  // τ of the current frame's first violation (0: none yet)
 };
 
 }  // namespace target

@@ -219,26 +219,29 @@ TargetFilter::Predicted TargetFilter::driven_now(const State& state, double dt) 
   return out;
 }
 
+void TargetFilter::apply_inflation(State& state) {
+  noise_ = options_.noise(adaptive_->sigma());
+  if (!(adaptive_->inflation() > 0.0)) return;
+  // Process noise the rejected σ left out (adaptive_noise.h), through the
+  // target's motion over the time it was used: the pose integrated it too.
+  const double tau = adaptive_->inflation_time();
+  const estimator::ImuValue imu = state.imu()->get();
+  const TargetStep missed = propagate_target(options_.representation, target_->get(), imu, imu, Matrix15d::Identity(),
+                                             Matrix15d::Zero(), tau, options_.noise(std::sqrt(adaptive_->inflation() / tau)));
+  StateHelper::propagate(state, {target_}, Matrix12d::Identity(), missed.Q_TT);
+}
+
 void TargetFilter::end_adaptive_frame(State& state) {
   if (!adaptive_ || !target_) return;
-  if (!predicted_) {
-    adaptive_->end_frame_innovations_only();
+  if (!predicted_ || inflated_this_frame_) {
+    adaptive_->end_frame_innovations_only(predicted_ ? predicted_->dt : 0.0);
   } else {
     const Predicted now = driven_now(state, 0.0);
     adaptive_->end_frame(predicted_->x, predicted_->P, now.x, now.P, predicted_->dt);
   }
-  if (adaptive_->inflation() > 0.0) {
-    // Process noise the rejected σ left out (adaptive_noise.h), through the
-    // target's motion over the time it was used: the pose integrated it too.
-    const double tau = adaptive_->inflation_time();
-    const estimator::ImuValue imu = state.imu()->get();
-    const TargetStep missed =
-        propagate_target(options_.representation, target_->get(), imu, imu, Matrix15d::Identity(),
-                         Matrix15d::Zero(), tau, options_.noise(std::sqrt(adaptive_->inflation() / tau)));
-    StateHelper::propagate(state, {target_}, Matrix12d::Identity(), missed.Q_TT);
-  }
+  apply_inflation(state);
   predicted_.reset();
-  noise_ = options_.noise(adaptive_->sigma());
+  inflated_this_frame_ = false;
   ++stats_.adaptive_frames;
   if (adaptive_->consistent()) ++stats_.adaptive_coupled_frames;
   stats_.adaptive_violations = adaptive_->violations();
@@ -636,12 +639,14 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
   }
   const bool use_fej = state.options().use_fej;
   struct Block {
+    int64_t id;
     TypePtr point;
     Eigen::MatrixXd H;  // [target pose (6), IMU pose (6, global), point (3)]
     Eigen::VectorXd r;
+    std::vector<TypePtr> order;
+    double chi2;
   };
-  std::vector<Block> accepted;
-  int rows = 0;
+  std::vector<Block> candidates;
   for (const auto& kv : by_point) {
     TargetPoint& pt = points_.at(kv.first);
     const Eigen::Vector3d p_FinT = pt.var->value();
@@ -669,19 +674,45 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
     std::vector<TypePtr> order{target_->pose()};
     if (global) order.push_back(state.imu()->pose());
     order.push_back(pt.var);
-    Eigen::MatrixXd S = H * StateHelper::marginal_covariance(state, order) * H.transpose();
-    S.diagonal().array() += 1.0;
-    const double chi2 = r.dot(S.llt().solve(r));
-    if (adaptive_) adaptive_->add_innovation(chi2, static_cast<int>(r.size()));
-    if (!(chi2 < options_.chi2_multiplier * estimator::chi2_95(static_cast<int>(r.size())))) {
+    candidates.push_back(Block{kv.first, pt.var, std::move(H), std::move(r), std::move(order), 0.0});
+  }
+  const auto compute_chi2 = [&state, &candidates](double* sum, int* dof) {
+    *sum = 0.0;
+    *dof = 0;
+    for (Block& b : candidates) {
+      Eigen::MatrixXd S = b.H * StateHelper::marginal_covariance(state, b.order) * b.H.transpose();
+      S.diagonal().array() += 1.0;
+      b.chi2 = b.r.dot(S.llt().solve(b.r));
+      *sum += b.chi2;
+      *dof += static_cast<int>(b.r.size());
+    }
+  };
+  double chi2_sum = 0.0;
+  int dof = 0;
+  compute_chi2(&chi2_sum, &dof);
+  // Adaptive: a frame whose points already violate the model takes the σ
+  // steps before its update (until consistent, or σ at its maximum), so its
+  // measurements correct the target rather than being gated out while σ
+  // is bracketed frame by frame — the target would drift meanwhile, and a
+  // frame its points were placed in then stays wrong (docs/target_model.md).
+  while (adaptive_ && predicted_ && adaptive_->inflate_before_update(chi2_sum, dof, predicted_->dt)) {
+    inflated_this_frame_ = true;
+    apply_inflation(state);
+    compute_chi2(&chi2_sum, &dof);
+  }
+  std::vector<Block> accepted;
+  int rows = 0;
+  for (Block& b : candidates) {
+    if (adaptive_) adaptive_->add_innovation(b.chi2, static_cast<int>(b.r.size()));
+    if (!(b.chi2 < options_.chi2_multiplier * estimator::chi2_95(static_cast<int>(b.r.size())))) {
       ++stats_.points_rejected_chi2;
       continue;
     }
-    pt.last_updated_frame = frame_;
+    points_.at(b.id).last_updated_frame = frame_;
     ++stats_.point_updates;
-    stats_.obs_used += row / 2;
-    rows += row;
-    accepted.push_back(Block{pt.var, std::move(H), std::move(r)});
+    stats_.obs_used += static_cast<int>(b.r.size()) / 2;
+    rows += static_cast<int>(b.r.size());
+    accepted.push_back(std::move(b));
   }
   if (accepted.empty()) return;
   estimator::ColumnLayout layout;

@@ -310,6 +310,9 @@ class TargetFilter : public estimator::VioExtension {
   // kAdaptive: closes the frame's covariance matching, sets noise_ to σ̂ and
   // inflates the target's covariance after a model violation.
   void end_adaptive_frame(estimator::State& state);
+  /// Adds the adaptive estimate's inflation() to the target (propagated
+  /// through its motion) and takes its σ for the next propagation.
+  void apply_inflation(estimator::State& state);
   // ekf_update (tightly_coupled()) or schmidt_update with nuisance_variables.
   bool apply_update(estimator::State& state, const std::vector<estimator::TypePtr>& order, const Eigen::MatrixXd& H,
                     const Eigen::VectorXd& r);
@@ -338,6 +341,7 @@ class TargetFilter : public estimator::VioExtension {
   // The driven components' values and variances now, with dt attached.
   Predicted driven_now(const estimator::State& state, double dt) const;
   double pending_dt_{0.0};
+  bool inflated_this_frame_{false};  // adaptive: σ stepped before this frame's update
 };
 
 }  // namespace target
