@@ -150,7 +150,7 @@ void AdaptiveNoise::save(estimator::CheckpointWriter* out) const {
   out->put(violations_);
   out->put(inflation_);
   out->put(inflation_time_);
-  out->put(frame_tau_);
+  // frame_tau_ is 0 between frames, where checkpoints are taken.
 }
 
 bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
@@ -176,7 +176,7 @@ bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
   a.violations_ = in->take<int64_t>();
   a.inflation_ = in->take<double>();
   a.inflation_time_ = in->take<double>();
-  a.frame_tau_ = in->take<double>();
+  a.frame_tau_ = 0.0;
   if (!in->ok() || !(a.sigma_ > 0.0)) return false;
   *this = std::move(a);
   return true;
