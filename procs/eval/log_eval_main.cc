@@ -49,8 +49,9 @@ int run(int argc, const char* const* argv) {
                   "evaluate only the states (and target states) at or after this utime, e.g. those of a\n"
                   "process restarted mid-run (its \"initialised from ground truth at utime N\")");
   args.add_option("compare-target", "SUMMARY_JSON",
-                  "with --target-channel: print the relative difference of the target figures to a\n"
-                  "one-run vimot-target-eval summary.json (its first target-filter cell)");
+                  "with --target-channel: print the relative difference of the target figures, and of the\n"
+                  "robot's on --state-channel (the target filter's NAV_STATE: moved by the target unless skf),\n"
+                  "to a one-run vimot-target-eval summary.json (its first target-filter cell)");
   args.add_option("scale-truth", "SUMMARY_JSON",
                   "evaluate the monocular scale pipeline too: SCALE_ESTIMATE, OBJECT_POSE_METRIC and OBJECT_STATE\n"
                   "against the truth of the object tracks in this one-run vimot-scale-eval summary.json\n"
@@ -236,6 +237,7 @@ int run(int argc, const char* const* argv) {
     const std::string cell = "cells/" + std::to_string(eval::first_target_cell_index(ref)) + "/per_run/0/";
     const eval::ErrorSummary oi = eval::read_summary_json(ref, cell + "target_in_imu");
     const eval::ErrorSummary ow = eval::read_summary_json(ref, cell + "target_in_world");
+    const eval::ErrorSummary orobot = eval::read_summary_json(ref, cell + "imu");
     const eval::ErrorSummary& li = r.target_in_imu;
     const eval::ErrorSummary& lw = r.target_in_world;
     const bool local = std::isnan(lw.nees_position);  // NEES only in the filter's representation
@@ -247,7 +249,12 @@ int run(int argc, const char* const* argv) {
                         {"target in world orientation [deg]", lw.rmse_orientation_deg, ow.rmse_orientation_deg},
                         {"target NEES position", ln.nees_position, on.nees_position},
                         {"target NEES orientation", ln.nees_orientation, on.nees_orientation},
-                        {"target samples", static_cast<double>(li.count), static_cast<double>(oi.count)}});
+                        {"target samples", static_cast<double>(li.count), static_cast<double>(oi.count)},
+                        {"robot position RMSE [m]", s.rmse_position_m, orobot.rmse_position_m},
+                        {"robot orientation RMSE [deg]", s.rmse_orientation_deg, orobot.rmse_orientation_deg},
+                        {"robot NEES position", s.nees_position, orobot.nees_position},
+                        {"robot NEES orientation", s.nees_orientation, orobot.nees_orientation},
+                        {"robot samples", static_cast<double>(s.count), static_cast<double>(orobot.count)}});
   }
   if (!opt.scale_channel.empty()) {
     const eval::ScaleFigures o = eval::read_scale_figures(args.get("scale-truth"), 0);

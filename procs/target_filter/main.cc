@@ -6,9 +6,12 @@
 // TARGET_STATE (target_state_t) and TARGET_PREDICTION (target_prediction_t).
 // All logic is in TargetFilterNode / the target library; this file moves bytes.
 
+#include <stdexcept>
+
 #include "common/process/lcm_conversions.h"
 #include "common/process/process.h"
 #include "common/process/node_runner.h"
+#include "common/target/target_filter_config.h"
 #include "procs/target_filter/target_filter_node.h"
 
 namespace {
@@ -22,6 +25,7 @@ int run(int argc, const char* const* argv) {
                          /*config_required=*/true);
   process.args().add_option("perturb-seed", "N",
                             "start from ground truth perturbed with this seed (overrides init.perturb_seed)");
+  process.args().add_option("mode", "MODE", "ekf, skf, adaptive or off (overrides target.mode)");
   process.args().add_option("checkpoint", "PATH",
                             "robot and target filter state written per update; a restart goes on from it if recent (input.bridge_max_gap_s)");
   vimot::add_catch_up_option(process.args());
@@ -32,6 +36,10 @@ int run(int argc, const char* const* argv) {
   vimot::TargetFilterNodeOptions options = vimot::node_options_from_config(process.config());
   if (process.args().given("checkpoint")) options.checkpoint_path = process.args().get("checkpoint");
   vimot::set_catch_up(process, &options, /*use_ground_truth=*/true);
+  if (process.args().given("mode")) {
+    if (!options.target_enabled) throw std::invalid_argument("--mode: target.mode is none (VIO only) in the config");
+    options.target.mode = vimot::target::parse_target_mode(process.args().get("mode"));
+  }
   if (process.args().given("perturb-seed")) {
     options.perturb_seed = static_cast<uint64_t>(process.args().get_int("perturb-seed"));
   }
