@@ -691,10 +691,11 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
   int dof = 0;
   compute_chi2(&chi2_sum, &dof);
   // Adaptive: a frame whose points already violate the model takes the σ
-  // steps before its update (until consistent, or σ at its maximum), so its
-  // measurements correct the target rather than being gated out while σ
-  // is bracketed frame by frame — the target would drift meanwhile, and a
-  // frame its points were placed in then stays wrong (docs/target_model.md).
+  // steps before its update (until the gate accepts them, or σ is at its
+  // maximum), so its measurements correct the target rather than being
+  // gated out while σ is bracketed frame by frame: the target would drift
+  // meanwhile, and points initialised then fix a wrong target frame for
+  // good (docs/target_model.md, "Adaptive target noise").
   while (adaptive_ && predicted_ && adaptive_->inflate_before_update(chi2_sum, dof, predicted_->dt)) {
     inflated_this_frame_ = true;
     apply_inflation(state);
