@@ -97,6 +97,8 @@ esac
 
 export VIMOT_BIN="$build/bin"
 export VIMOT_CONFIG="$here/config"
+# shellcheck source=scripts/run_figures.sh
+source "$here/scripts/run_figures.sh"  # target_key
 if [ $pipeline = mono ]; then
   pmd="$here/sheriff_configs/sim_mono.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_mono.yaml}"
@@ -138,7 +140,7 @@ else
   pmd="$here/sheriff_configs/sim_demo.pmd"
   export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}"
   # target.mode of config/target_filter.yaml unless overridden (--mode of vimot-target-filter).
-  export VIMOT_TARGET_MODE="${VIMOT_TARGET_MODE:-$(sed -n 's/^  mode: *\([a-z]*\).*/\1/p' "$VIMOT_CONFIG/target_filter.yaml" | head -n 1)}"
+  export VIMOT_TARGET_MODE="${VIMOT_TARGET_MODE:-$(target_key mode)}"
 fi
 if [ -n "${VIMOT_TARGET_MODE:-}" ] && [ "$pmd" != "$here/sheriff_configs/sim_demo.pmd" ]; then
   echo "demo.sh: VIMOT_TARGET_MODE applies to the default pipeline only (sheriff_configs/sim_demo.pmd)" >&2
@@ -267,7 +269,6 @@ fi
   --compare "$out/lcm_summary.json" | sed 's/^/   /'
 echo "== target accuracy of the LCM run (TARGET_STATE vs GROUND_TRUTH), and the offline run:"
 target_cfg="$VIMOT_CONFIG/target_filter.yaml"
-target_key() { sed -n "s/^  $1: *\([a-z0-9.]*\).*/\1/p" "$target_cfg" | head -n 1; }
 # init.mode features: the filter's own target frame, compared through the fixed transform.
 own_frame=""
 if sed -n '/^  init:/,/^  [a-z_]*:/p' "$target_cfg" | grep -q '^    mode: *features'; then own_frame="--own-target-frame"; fi

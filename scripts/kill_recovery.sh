@@ -43,7 +43,7 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${VIMOT_BUILD_DIR:-$here/build}/bin"
 # shellcheck source=scripts/run_figures.sh
-source "$here/scripts/run_figures.sh"  # evaluate, rmse_vio, rmse_target
+source "$here/scripts/run_figures.sh"  # evaluate, rmse_vio, rmse_target, target_key
 
 mode=local
 victims="vins target_filter sim logger"
@@ -72,7 +72,7 @@ export VIMOT_BIN="$bin" VIMOT_CONFIG="$here/config"
 export VIMOT_SIM_CONFIG="${VIMOT_SIM_CONFIG:-sim_paper.yaml}" VIMOT_VINS_CONFIG="${VIMOT_VINS_CONFIG:-vins.yaml}"
 export VIMOT_SPEED="${VIMOT_SPEED:-1}" VIMOT_SEED="${VIMOT_SEED:-1}"
 # sim_demo.pmd's target filter mode: the config's, as the replays below use it.
-export VIMOT_TARGET_MODE="$(sed -n 's/^  mode: *\([a-z]*\).*/\1/p' "$VIMOT_CONFIG/target_filter.yaml" | head -n 1)"
+export VIMOT_TARGET_MODE="$(target_key mode)"
 export LCM_DEFAULT_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7698?ttl=0&recv_buf_size=4194304}"
 pmd="$here/sheriff_configs/sim_demo.pmd"
 out="${VIMOT_OUT:-$here/out/kill-recovery-$(date +%Y%m%d-%H%M%S)}"

@@ -1,5 +1,10 @@
-# Sourced by scripts/kill_recovery.sh and scripts/outage_sweep.sh: how both
-# score a run's log (vimot-log-eval; needs $bin, the executables' folder).
+# Sourced by scripts/kill_recovery.sh, scripts/outage_sweep.sh and
+# scripts/demo.sh: how they score a run's log (vimot-log-eval; needs $bin, the
+# executables' folder) and read the target filter's config.
+
+# target_key KEY: the value of target.KEY in $VIMOT_CONFIG/target_filter.yaml
+# (a key of the target: section itself, e.g. mode, representation, sigma_t).
+target_key() { sed -n "s/^  $1: *\([a-z0-9.]*\).*/\1/p" "$VIMOT_CONFIG/target_filter.yaml" | head -n 1; }
 
 # evaluate DIR LOG: vimot-log-eval of VINS_STATE and of NAV_STATE + TARGET_STATE
 # (the target in one frame of the filter's own for the whole run).
