@@ -18,6 +18,9 @@ void AdaptiveNoiseOptions::validate() const {
   if (!(nis_max > 1.0)) throw std::invalid_argument("adaptive: nis_max must be > 1");
   if (!(max_step > 1.0) || !std::isfinite(max_step)) throw std::invalid_argument("adaptive: max_step must be > 1");
   if (!(hold_s >= 0.0) || !std::isfinite(hold_s)) throw std::invalid_argument("adaptive: hold_s must be >= 0");
+  if (horizon < 1 || horizon > window) {
+    throw std::invalid_argument("adaptive: horizon must be in [1, window], got " + std::to_string(horizon));
+  }
 }
 
 AdaptiveNoise::AdaptiveNoise(const AdaptiveNoiseOptions& options, double sigma0) : options_(options) {
@@ -45,24 +48,55 @@ double AdaptiveNoise::window_nis() const {
 void AdaptiveNoise::end_frame(const Eigen::VectorXd& x_minus, const Eigen::VectorXd& P_minus,
                               const Eigen::VectorXd& x_plus, const Eigen::VectorXd& P_plus, double dt) {
   const Eigen::Index n = x_minus.size();
-  if (x_plus.size() != n || P_minus.size() != n || P_plus.size() != n || !(dt > 0.0)) {
-    throw std::invalid_argument("AdaptiveNoise::end_frame: sizes differ or dt <= 0");
+  if (x_plus.size() != n || P_minus.size() != n || P_plus.size() != n || !(dt > 0.0) || n < 1 ||
+      n > kMaxComponents) {
+    throw std::invalid_argument("AdaptiveNoise::end_frame: sizes differ, not 1.." +
+                                std::to_string(kMaxComponents) + ", or dt <= 0");
   }
   Frame f;
   const double q_used = sigma_ * sigma_ * dt;
   for (Eigen::Index j = 0; j < n; ++j) {
-    const double dx = x_plus(j) - x_minus(j);
-    f.q_sum += dx * dx - (P_minus(j) - P_plus(j)) + q_used;
-    f.unit_sum += dt;
+    f.dx[static_cast<size_t>(j)] = x_plus(j) - x_minus(j);
+    f.c_sum += q_used - (P_minus(j) - P_plus(j));
   }
+  f.components = static_cast<int>(n);
   f.dt = dt;
-  finish(f, true);
+  finish(f);
 }
 
 void AdaptiveNoise::end_frame_innovations_only(double dt) {
   Frame f;
   f.dt = std::max(dt, 0.0);
-  finish(f, false);
+  finish(f);
+}
+
+bool AdaptiveNoise::window_density(double* q_density) const {
+  const int h = options_.horizon;
+  double q = 0.0, unit = 0.0;
+  // Every run of h consecutive matching frames (a frame without matching
+  // breaks the run: its correction is not in the sum).
+  for (size_t end = 0; end < window_.size(); ++end) {
+    if (end + 1 < static_cast<size_t>(h)) continue;
+    const size_t begin = end + 1 - static_cast<size_t>(h);
+    const int n = window_[begin].components;
+    std::array<double, kMaxComponents> dx_sum{};
+    double c = 0.0, dt = 0.0;
+    bool complete = n > 0;
+    for (size_t i = begin; complete && i <= end; ++i) {
+      const Frame& f = window_[i];
+      complete = f.components == n;
+      for (int j = 0; j < n; ++j) dx_sum[static_cast<size_t>(j)] += f.dx[static_cast<size_t>(j)];
+      c += f.c_sum;
+      dt += f.dt;
+    }
+    if (!complete) continue;
+    for (int j = 0; j < n; ++j) q += dx_sum[static_cast<size_t>(j)] * dx_sum[static_cast<size_t>(j)];
+    q += c;
+    unit += n * dt;
+  }
+  if (!(unit > 0.0)) return false;
+  *q_density = q / unit;
+  return true;
 }
 
 bool AdaptiveNoise::violates(double chi2, int dof) const {
@@ -99,7 +133,7 @@ bool AdaptiveNoise::inflate_before_update(double chi2, int dof, double dt) {
   return true;
 }
 
-void AdaptiveNoise::finish(Frame f, bool has_matching) {
+void AdaptiveNoise::finish(Frame f) {
   f.chi2 = frame_chi2_;
   f.dof = frame_dof_;
   frame_chi2_ = 0.0;
@@ -114,20 +148,14 @@ void AdaptiveNoise::finish(Frame f, bool has_matching) {
   window_.push_back(f);
   while (static_cast<int>(window_.size()) > options_.window) window_.pop_front();
   ++frames_since_violation_;
-  if (has_matching) {
-    double q = 0.0, unit = 0.0;
-    for (const Frame& w : window_) {
-      q += w.q_sum;
-      unit += w.unit_sum;
-    }
-    // Half a window of evidence before σ̂ replaces the current value.
-    if (unit > 0.0 && 2 * static_cast<int>(window_.size()) >= options_.window) {
-      matched_ = std::clamp(std::sqrt(std::max(q / unit, 0.0)), options_.sigma_min, options_.sigma_max);
-      while (!recent_.empty() && recent_.front().first < time_ - options_.hold_s) recent_.pop_front();
-      while (!recent_.empty() && recent_.back().second <= matched_) recent_.pop_back();  // never the max again
-      recent_.emplace_back(time_, matched_);
-      sigma_ = recent_.front().second;
-    }
+  double q_density = 0.0;
+  // Half a window of evidence before σ̂ replaces the current value.
+  if (f.components > 0 && 2 * static_cast<int>(window_.size()) >= options_.window && window_density(&q_density)) {
+    matched_ = std::clamp(std::sqrt(std::max(q_density, 0.0)), options_.sigma_min, options_.sigma_max);
+    while (!recent_.empty() && recent_.front().first < time_ - options_.hold_s) recent_.pop_front();
+    while (!recent_.empty() && recent_.back().second <= matched_) recent_.pop_back();  // never the max again
+    recent_.emplace_back(time_, matched_);
+    sigma_ = recent_.front().second;
   }
   consistent_ = frames_since_violation_ >= options_.window && window_nis() <= options_.nis_max;
 }
@@ -168,7 +196,10 @@ bool AdaptiveNoise::load(estimator::CheckpointReader* in) {
   const int64_t n = in->take<int64_t>();
   if (n < 0 || n > options_.window) return false;
   a.window_.clear();
-  for (int64_t i = 0; i < n; ++i) a.window_.push_back(in->take<Frame>());
+  for (int64_t i = 0; i < n; ++i) {
+    a.window_.push_back(in->take<Frame>());
+    if (a.window_.back().components < 0 || a.window_.back().components > kMaxComponents) return false;
+  }
   a.frame_chi2_ = in->take<double>();
   a.frame_dof_ = in->take<int>();
   a.frames_since_violation_ = in->take<int>();

@@ -10,6 +10,14 @@
 // if σ is right, and each frame gives the unbiased sample
 //   q̂_j = Δx_j² − (P⁻_jj − P⁺_jj) + σ_used² dt.
 // Over a window of W frames, σ̂² = Σ q̂ / Σ dt (per component), clamped.
+// Horizon h > 1 squares the corrections summed over h consecutive frames,
+//   q̂_j = (Σ_h Δx_j)² − Σ_h (P⁻_jj − P⁺_jj) + Σ_h σ_used² dt,
+// over every run of h frames in the window: still unbiased when σ is right
+// (a right model's corrections K r are uncorrelated from frame to frame),
+// but a sustained acceleration, which a white-noise model sees as
+// corrections of one sign frame after frame, counts as the (Σ a dt)² it
+// drives over h frames rather than as h samples of (a dt)²: the density
+// the filter needs over its own memory, not the per-frame mean.
 //
 // Consistency: the normalised innovation squared of the target's measurement
 // blocks (χ² before the gate, so rejected blocks count) per frame and over
@@ -37,6 +45,7 @@
 // hardest recent manoeuvre up at once and forgets it only after hold_s.
 
 #include <Eigen/Core>
+#include <array>
 #include <deque>
 
 #include "common/estimator/checkpoint.h"
@@ -54,6 +63,7 @@ struct AdaptiveNoiseOptions {
   double nis_max{2.0};
   double max_step{4.0};     // largest σ² factor of one violating frame
   double hold_s{0.0};       // [s] σ = the largest windowed σ̂ of this long (0: the latest)
+  int horizon{1};           // frames whose corrections are summed before squaring (<= window)
   /// Throws std::invalid_argument naming the bad option.
   void validate() const;
 };
@@ -99,14 +109,18 @@ class AdaptiveNoise {
   bool load(estimator::CheckpointReader* in);
 
  private:
+  static constexpr int kMaxComponents = 6;
   struct Frame {
-    double q_sum{0.0};     // Σ_j q̂_j
-    double unit_sum{0.0};  // Σ_j dt
+    std::array<double, kMaxComponents> dx{};  // Δx_j of the frame's updates
+    int components{0};     // driven components (0: no matching in this frame)
+    double c_sum{0.0};     // Σ_j σ_used² dt − (P⁻_jj − P⁺_jj)
     double dt{0.0};
     double chi2{0.0};
     int dof{0};
   };
-  void finish(Frame f, bool has_matching);
+  void finish(Frame f);
+  /// σ̂² of the window (false when it holds no complete horizon).
+  bool window_density(double* q_density) const;
   bool violates(double chi2, int dof) const;
   /// The violation's bookkeeping and σ step (NIS of the violating blocks).
   void violate(double nis, double dt);

@@ -109,7 +109,7 @@ TargetSection target_section_from_config(const Config& config) {
     o.point_max_lost_frames = at_least(p, "max_lost_frames", o.point_max_lost_frames, 1);
   }
   if (c.has("adaptive")) {
-    c.check_keys("adaptive", {"window", "sigma_min", "sigma_max", "nis_max", "max_step", "hold_s"});
+    c.check_keys("adaptive", {"window", "sigma_min", "sigma_max", "nis_max", "max_step", "hold_s", "horizon"});
     const Config a = c.sub("adaptive");
     AdaptiveNoiseOptions& ad = o.adaptive;
     ad.window = at_least(a, "window", ad.window, 2);
@@ -118,6 +118,8 @@ TargetSection target_section_from_config(const Config& config) {
     ad.nis_max = positive(a, "nis_max", ad.nis_max);
     ad.max_step = positive(a, "max_step", ad.max_step);
     ad.hold_s = non_negative(a, "hold_s", ad.hold_s);
+    ad.horizon = at_least(a, "horizon", ad.horizon, 1);
+    if (ad.horizon > ad.window) a.fail("horizon", "must be <= window (" + std::to_string(ad.window) + ")");
     if (!(ad.sigma_max >= ad.sigma_min)) a.fail("sigma_max", "must be >= sigma_min");
     if (!(ad.nis_max > 1.0)) a.fail("nis_max", "must be > 1, got " + std::to_string(ad.nis_max));
     if (!(ad.max_step > 1.0)) a.fail("max_step", "must be > 1, got " + std::to_string(ad.max_step));

@@ -42,8 +42,9 @@ struct Use {
   bool gate{false};           // drop the frame's measurements above χ²_0.95(3), as the filter's gate
   bool inflate{false};        // add inflation() after a violating frame
   bool before_update{false};  // and take the σ steps before a violating frame's update
-  double accel_from{-1.0};    // [s] the truth accelerates at 1 m/s² on every axis
+  double accel_from{-1.0};    // [s] the truth accelerates at `accel` on every axis
   double accel_to{-1.0};      //     from accel_from to accel_to (a car speeding up)
+  double accel{1.0};          // [m/s²]
 };
 
 // Variance of the missed noise over τ (density² = variance / τ) on [p, v]:
@@ -77,7 +78,7 @@ RunResult run(uint64_t seed, int frames, double sigma0, SigmaOf sigma_true, int 
     Eigen::VectorXd xm(3), Pm(3), xp(3), Pp(3);
     double z[3];
     const double t = k * kDt;
-    const double accel = t >= use.accel_from && t < use.accel_to ? 1.0 : 0.0;
+    const double accel = t >= use.accel_from && t < use.accel_to ? use.accel : 0.0;
     for (int a = 0; a < 3; ++a) {
       Axis& ax = axes[a];
       // Truth: fine steps of the continuous random walk.
@@ -179,6 +180,50 @@ TEST_CASE("adaptive noise: the estimate follows a step of the true density", "[a
       CHECK(std::abs(s2 / 0.3 - 1.0) < 0.2);
     }
   }
+}
+
+TEST_CASE("adaptive noise: a horizon of frames is unbiased when the model is right", "[adaptive]") {
+  // The step test's truth with the corrections summed over 10 frames: a right
+  // model's corrections are uncorrelated, so the sum's square matches the
+  // same density (adaptive_noise.h).
+  AdaptiveNoiseOptions options;
+  options.horizon = 10;
+  const int half = 2400;
+  const auto truth = [&](int k) { return k < half ? 0.05 : 0.3; };
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    const RunResult r = run(seed, 2 * half, 0.05, truth, -1, options);
+    const double s1 = rms(r.sigma, half / 2, half);
+    const double s2 = rms(r.sigma, half + half / 2, 2 * half);
+    INFO("seed " << seed << ": " << s1 << " (true 0.05), " << s2 << " (true 0.3)");
+    CHECK(std::abs(s1 / 0.05 - 1.0) < 0.2);
+    CHECK(std::abs(s2 / 0.3 - 1.0) < 0.2);
+  }
+}
+
+TEST_CASE("adaptive noise: the horizon squares the summed corrections, by hand", "[adaptive]") {
+  // Frames whose covariance terms cancel (P⁻ − P⁺ = σ_used² dt), so a block's
+  // sample is (Σ Δx)² per component and σ̂² = Σ blocks (Σ Δx)² / Σ blocks h dt.
+  // Corrections of one sign every frame (a lag the model reads as noise):
+  // h d² / dt, growing with h. Alternating signs (the overcorrection of a
+  // gain too large): 0 for an even h, d² / dt for h = 1 that ignores the
+  // correlation (Mehra's whiteness of a right model's innovations).
+  const double d = 0.01;
+  const auto matched = [&](int horizon, bool alternate) {
+    AdaptiveNoiseOptions o;
+    o.horizon = horizon;
+    AdaptiveNoise est(o, 0.1);
+    for (int k = 0; k < o.window; ++k) {
+      const double dx = alternate && k % 2 ? -d : d;
+      const double s2dt = est.sigma() * est.sigma() * kDt;
+      est.end_frame(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(s2dt), Eigen::Vector3d::Constant(dx),
+                    Eigen::Vector3d::Zero(), kDt);
+    }
+    return est.matched_sigma();
+  };
+  CHECK(matched(1, false) == Approx(std::sqrt(d * d / kDt)));
+  CHECK(matched(10, false) == Approx(std::sqrt(10 * d * d / kDt)));
+  CHECK(matched(1, true) == Approx(std::sqrt(d * d / kDt)));
+  CHECK(matched(2, true) == AdaptiveNoiseOptions{}.sigma_min);  // (d − d)² = 0, clamped
 }
 
 TEST_CASE("adaptive noise: the hold keeps the largest recent estimate", "[adaptive]") {
@@ -319,6 +364,11 @@ TEST_CASE("adaptive noise: bad options are refused", "[adaptive]") {
   CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
   o = AdaptiveNoiseOptions{};
   o.nis_max = 1.0;
+  CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
+  o = AdaptiveNoiseOptions{};
+  o.horizon = o.window + 1;
+  CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
+  o.horizon = 0;
   CHECK_THROWS_AS(AdaptiveNoise(o, 0.1), std::invalid_argument);
   AdaptiveNoise est(AdaptiveNoiseOptions{}, 0.1);
   CHECK_THROWS_AS(est.end_frame(Eigen::VectorXd(3), Eigen::VectorXd(2), Eigen::VectorXd(3), Eigen::VectorXd(3), kDt),
