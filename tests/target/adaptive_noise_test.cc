@@ -183,20 +183,22 @@ TEST_CASE("adaptive noise: the estimate follows a step of the true density", "[a
 }
 
 TEST_CASE("adaptive noise: a horizon of frames is unbiased when the model is right", "[adaptive]") {
-  // The step test's truth with the corrections summed over 10 frames: a right
-  // model's corrections are uncorrelated, so the sum's square matches the
-  // same density (adaptive_noise.h).
+  // The step test's truth and starts with the corrections summed over 10
+  // frames: a right model's corrections are uncorrelated, so the sum's
+  // square matches the same density (adaptive_noise.h).
   AdaptiveNoiseOptions options;
   options.horizon = 10;
   const int half = 2400;
   const auto truth = [&](int k) { return k < half ? 0.05 : 0.3; };
-  for (uint64_t seed = 1; seed <= 3; ++seed) {
-    const RunResult r = run(seed, 2 * half, 0.05, truth, -1, options);
-    const double s1 = rms(r.sigma, half / 2, half);
-    const double s2 = rms(r.sigma, half + half / 2, 2 * half);
-    INFO("seed " << seed << ": " << s1 << " (true 0.05), " << s2 << " (true 0.3)");
-    CHECK(std::abs(s1 / 0.05 - 1.0) < 0.2);
-    CHECK(std::abs(s2 / 0.3 - 1.0) < 0.2);
+  for (const double sigma0 : {0.001, 0.5}) {
+    for (uint64_t seed = 1; seed <= 3; ++seed) {
+      const RunResult r = run(seed, 2 * half, sigma0, truth, -1, options);
+      const double s1 = rms(r.sigma, half / 2, half);
+      const double s2 = rms(r.sigma, half + half / 2, 2 * half);
+      INFO("sigma0 " << sigma0 << " seed " << seed << ": " << s1 << " (true 0.05), " << s2 << " (true 0.3)");
+      CHECK(std::abs(s1 / 0.05 - 1.0) < 0.2);
+      CHECK(std::abs(s2 / 0.3 - 1.0) < 0.2);
+    }
   }
 }
 
