@@ -302,7 +302,8 @@ bool TargetFilter::propagate_jointly(const State& state, const estimator::ImuVal
     if (options_.observability_constraint) {
       constrain_observability(
           joint_unobservable_directions(options_.representation, state.imu()->get_fej(), target_->get_fej()),
-          joint_unobservable_directions(options_.representation, x1, step.x), &step);
+          joint_unobservable_directions(options_.representation, x1, step.x),
+          noise_invariant_directions(options_.planar), &step);
     }
   }
   Eigen::Matrix<double, 27, 27> F, Qd;

@@ -162,11 +162,11 @@ struct TargetFilterOptions {
   double chi2_multiplier{1.0};
   int min_clone_times{2};
   /// With the estimator's FEJ: constrain the target rows of the joint
-  /// transition so that it maps the unobservable directions (target gauge,
-  /// world yaw and position) at one first estimate onto those at the next
-  /// (target::constrain_observability; docs/target_model.md). Off by default:
-  /// with it the target's roll about its heading grows over-confident over
-  /// a whole run, without it the whole-run NEES stays in the band.
+  /// transition so that it maps the directions that stay unobservable under
+  /// the target's noise (target::noise_invariant_directions: planar, the
+  /// target's yaw and vertical shift; world yaw and position) at one first
+  /// estimate onto those at the next (docs/target_model.md). Off by default:
+  /// FEJ alone measured as well (NEES in the band, same accuracy).
   bool observability_constraint{false};
   // Target points in the state (0 disables them: MSCKF-only target updates).
   int max_target_points{25};

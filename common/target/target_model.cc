@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "common/math/quat.h"
 #include "common/target/target_conversion.h"
@@ -256,13 +257,26 @@ JointNullspace joint_unobservable_directions(TargetRepresentation representation
   return N;
 }
 
-void constrain_observability(const JointNullspace& U, const JointNullspace& W, TargetStep* step) {
+std::vector<int> noise_invariant_directions(bool planar) {
+  return planar ? std::vector<int>{2, 5, 6, 7, 8, 9} : std::vector<int>{0, 1, 2, 6, 7, 8, 9};
+}
+
+void constrain_observability(const JointNullspace& U, const JointNullspace& W, const std::vector<int>& columns,
+                             TargetStep* step) {
+  const Eigen::Index n = static_cast<Eigen::Index>(columns.size());
+  Eigen::Matrix<double, 27, Eigen::Dynamic> U_c(27, n), W_c(27, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int c = columns[static_cast<size_t>(i)];
+    if (c < 0 || c >= U.cols()) throw std::invalid_argument("constrain_observability: no column " + std::to_string(c));
+    U_c.col(i) = U.col(c);
+    W_c.col(i) = W.col(c);
+  }
   Eigen::Matrix<double, 12, 27> Phi_T;
   Phi_T << step->Phi_TI, step->Phi_TT;
-  // U has full column rank (its IMU rows separate the world columns from the
-  // target ones), so U⁺ = (UᵀU)⁻¹Uᵀ.
-  const Eigen::Matrix<double, 10, 27> U_pinv = (U.transpose() * U).ldlt().solve(U.transpose());
-  Phi_T -= (Phi_T * U - W.bottomRows<12>()) * U_pinv;
+  // U's columns are independent (its IMU rows separate the world columns from
+  // the target ones), so U_c⁺ = (U_cᵀU_c)⁻¹U_cᵀ.
+  const Eigen::MatrixXd U_pinv = (U_c.transpose() * U_c).ldlt().solve(U_c.transpose());
+  Phi_T -= (Phi_T * U_c - W_c.bottomRows<12>()) * U_pinv;
   step->Phi_TI = Phi_T.leftCols<15>();
   step->Phi_TT = Phi_T.rightCols<12>();
 }

@@ -36,6 +36,8 @@
 //     single IMU step or for a whole camera interval (Φ_II, Q_II of
 //     Propagator::predict_interval, dt the interval length).
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "common/estimator/propagator.h"
@@ -147,13 +149,27 @@ using JointNullspace = Eigen::Matrix<double, 27, 10>;
 JointNullspace joint_unobservable_directions(TargetRepresentation representation, const estimator::ImuValue& imu,
                                              const TargetValue& x);
 
+/// The columns of joint_unobservable_directions that stay unobservable under
+/// the target's process noise. A gauge changes v, w with the state ([v×]α,
+/// [w×]α, [w×]t), so along a run it needs the noise increments changed too;
+/// it is exact only if that change is an isometry of the noise (the
+/// likelihood is unchanged). Planar (v_x, v_y, w_z driven, isotropic in the
+/// plane): the yaw (2) and the shift along z (5) — a roll or pitch moves
+/// Δv_y, Δv_x into the undriven v_z (observable), an in-plane shift adds
+/// [Δw×]t to Δv (a shear: weakly observable). Not planar: the three
+/// rotations (0–2). Always the world's (6–9).
+std::vector<int> noise_invariant_directions(bool planar);
+
 /// Observability constraint (OC-EKF, Huang, Mourikis, Roumeliotis): the
 /// smallest (Frobenius) change of the target rows [Φ_TI Φ_TT] of the joint
-/// transition that maps U, the unobservable directions at t_k's linearisation
-/// point, exactly onto W, those at t_k+1's:
-///   [Φ_TI Φ_TT] ← [Φ_TI Φ_TT] − ([Φ_TI Φ_TT] U − W_T) U⁺   (W_T: target rows of W).
-/// The IMU rows are the estimator's (its FEJ already maps them).
-void constrain_observability(const JointNullspace& U, const JointNullspace& W, TargetStep* step);
+/// transition that maps the given columns of U, the unobservable directions
+/// at t_k's linearisation point, exactly onto those of W, at t_k+1's:
+///   [Φ_TI Φ_TT] ← [Φ_TI Φ_TT] − ([Φ_TI Φ_TT] U_c − W_c,T) U_c⁺   (W_c,T: target rows).
+/// The IMU rows are the estimator's (its FEJ already maps them). The filter
+/// passes noise_invariant_directions: constraining an observable direction
+/// (e.g. the planar target's roll) makes the filter over-confident along it.
+void constrain_observability(const JointNullspace& U, const JointNullspace& W, const std::vector<int>& columns,
+                             TargetStep* step);
 
 // ---------------------------------------------------------------------------
 // Prediction of the target alone (no measurements)

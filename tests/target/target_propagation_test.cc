@@ -7,6 +7,7 @@
 #include "common/math/quat.h"
 #include "common/target/target_conversion.h"
 #include "common/target/target_measurement.h"
+#include "common/target/target_filter.h"
 #include "common/target/target_model.h"
 #include "target_test_util.h"
 
@@ -27,6 +28,8 @@ TargetNoise sample_noise() {
   n.sigma_w = Eigen::Vector3d(0.05, 0.1, 0.2);
   return n;
 }
+
+std::vector<int> all_columns() { return {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}; }
 
 double min_eig(const Eigen::MatrixXd& M) {
   return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M).eigenvalues().minCoeff();
@@ -460,7 +463,7 @@ TEST_CASE("observability constraint: the first-estimate step maps the directions
     joint_transition(Phi_II, Q_II, lin, &Phi, nullptr);
     const double before = (Phi * U - W).bottomRows<12>().cwiseAbs().maxCoeff();
     const TargetStep unconstrained = lin;
-    constrain_observability(U, W, &lin);
+    constrain_observability(U, W, all_columns(), &lin);
     joint_transition(Phi_II, Q_II, lin, &Phi, nullptr);
     const double after = (Phi * U - W).bottomRows<12>().cwiseAbs().maxCoeff();
     Eigen::Matrix<double, 12, 27> change;
@@ -478,8 +481,85 @@ TEST_CASE("observability constraint: the first-estimate step maps the directions
                                                  sample_noise(), &imu1e, &Phi_II, &Q_II);
     const TargetStep exact0 = exact;
     constrain_observability(joint_unobservable_directions(rep, imu, x),
-                            joint_unobservable_directions(rep, imu1e, exact.x), &exact);
+                            joint_unobservable_directions(rep, imu1e, exact.x), all_columns(), &exact);
     CHECK((exact.Phi_TT - exact0.Phi_TT).cwiseAbs().maxCoeff() < 1e-10);
     CHECK((exact.Phi_TI - exact0.Phi_TI).cwiseAbs().maxCoeff() < 1e-10);
   }
+}
+
+TEST_CASE("observability constraint: only the gauges the process noise keeps, and only those constrained",
+          "[target]") {
+  const ImuValue imu = test::sample_imu();
+  const TargetValue x = test::sample_target();
+  for (const bool planar : {true, false}) {
+    INFO((planar ? "planar" : "all six rates driven"));
+    TargetFilterOptions options;
+    options.planar = planar;
+    const TargetNoise noise = options.noise(0.3);
+    Eigen::Matrix<double, 6, 1> var;
+    var << noise.sigma_v.cwiseAbs2(), noise.sigma_w.cwiseAbs2();
+    // A gauge column's v, w rows depend on v, w, so along a run it needs each
+    // noise increment n = (Δv, Δw) changed by M n, M its derivative in (v, w)
+    // (finite differences of the columns). The gauge stays exact only if that
+    // is an isometry of the noise: M keeps the driven components among
+    // themselves and Σ⁻¹M is skew on them.
+    std::vector<int> invariant;
+    for (int c = 0; c < 6; ++c) {
+      const Eigen::MatrixXd M = central_diff(6, [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
+        TargetValue y = x;
+        y.v_TinT += d.head<3>();
+        y.w_TinT += d.tail<3>();
+        return joint_unobservable_directions(TargetRepresentation::kLocal, imu, y).col(c).segment<6>(21);
+      });
+      double leak = 0.0, asym = 0.0;
+      for (int i = 0; i < 6; ++i) {
+        for (int j = 0; j < 6; ++j) {
+          if (var(j) == 0.0) continue;
+          if (var(i) == 0.0) {
+            leak = std::max(leak, std::abs(M(i, j)));
+          } else {
+            asym = std::max(asym, std::abs(M(i, j) / var(i) + M(j, i) / var(j)));
+          }
+        }
+      }
+      INFO("column " << c << ": into undriven " << leak << ", not skew " << asym);
+      if (leak < 1e-8 && asym < 1e-6) invariant.push_back(c);
+    }
+    for (const int c : {6, 7, 8, 9}) invariant.push_back(c);  // the world's: the target noise does not move them
+    CHECK(invariant == noise_invariant_directions(planar));
+
+    // The constraint with those columns maps them, and changes Φ only in their span.
+    ImuValue imu_lin = imu;
+    imu_lin.p_IinG += Eigen::Vector3d(0.01, 0.02, -0.01);
+    Vector12d dx;
+    dx << 0.003, -0.002, 0.001, 0.01, -0.02, 0.015, 0.05, -0.03, 0.02, 0.02, -0.01, 0.03;
+    const Eigen::Vector3d w_m = imu.bg + Eigen::Vector3d(0.4, -0.7, 1.1);
+    const Eigen::Vector3d a_m(0.7, -0.4, 9.9);
+    ImuValue imu1;
+    Matrix15d Phi_II, Q_II;
+    const TargetStep mean = propagate_target_imu_step(TargetRepresentation::kGlobal, x, imu, imu_lin, w_m, a_m, 0.1,
+                                                      kGravity, ImuNoise{}, noise, &imu1, &Phi_II, &Q_II);
+    TargetStep lin = propagate_target(TargetRepresentation::kGlobal, boxplus(x, dx), imu_lin, imu1, Phi_II, Q_II, 0.1,
+                                      noise);
+    const TargetStep unconstrained = lin;
+    const JointNullspace U = joint_unobservable_directions(TargetRepresentation::kGlobal, imu_lin, boxplus(x, dx));
+    const JointNullspace W = joint_unobservable_directions(TargetRepresentation::kGlobal, imu1, mean.x);
+    constrain_observability(U, W, invariant, &lin);
+    Eigen::Matrix<double, 27, 27> Phi;
+    joint_transition(Phi_II, Q_II, lin, &Phi, nullptr);
+    Eigen::MatrixXd U_c(27, invariant.size()), W_c(27, invariant.size());
+    for (size_t i = 0; i < invariant.size(); ++i) {
+      U_c.col(static_cast<Eigen::Index>(i)) = U.col(invariant[i]);
+      W_c.col(static_cast<Eigen::Index>(i)) = W.col(invariant[i]);
+    }
+    CHECK((Phi * U_c - W_c).bottomRows<12>().cwiseAbs().maxCoeff() < 1e-12);
+    Eigen::Matrix<double, 12, 27> change;
+    change << lin.Phi_TI - unconstrained.Phi_TI, lin.Phi_TT - unconstrained.Phi_TT;
+    const Eigen::MatrixXd P_U = U_c * (U_c.transpose() * U_c).inverse() * U_c.transpose();
+    CHECK(change.cwiseAbs().maxCoeff() > 1e-6);
+    CHECK((change - change * P_U).cwiseAbs().maxCoeff() < 1e-12);
+  }
+  TargetStep step;
+  CHECK_THROWS_AS(constrain_observability(JointNullspace::Zero(), JointNullspace::Zero(), {10}, &step),
+                  std::invalid_argument);
 }
