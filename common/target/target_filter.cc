@@ -650,6 +650,14 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
   std::vector<Block> candidates;
   for (const auto& kv : by_point) {
     TargetPoint& pt = points_.at(kv.first);
+    // The first triangulation can be centimetres off, a large error in the
+    // lever arm of T's orientation; moving the linearisation point with the
+    // covariance carried along the gauge keeps the gauge out of the update.
+    if (use_fej && options_.relinearize_points && pt.var->value() != pt.var->fej()) {
+      StateHelper::transform_variable(state, pt.var, {target_->pose(), pt.var},
+                                      point_relinearization(pt.var->fej(), pt.var->value()));
+      pt.var->set_fej(pt.var->value());
+    }
     const Eigen::Vector3d p_FinT = pt.var->value();
     const Eigen::Vector3d p_FinT_fej = pt.var->fej();
     const int m = static_cast<int>(kv.second.size());

@@ -172,6 +172,10 @@ struct TargetFilterOptions {
   int max_target_points{25};
   int point_init_clone_times{3};
   int point_max_lost_frames{10};
+  /// With FEJ: an in-state point is linearised at its current estimate, its
+  /// covariance carried along the target's gauge (point_relinearization);
+  /// false keeps its first triangulation for good (docs/target_model.md).
+  bool relinearize_points{true};
   estimator::TriangulationOptions triangulation;
 
   TargetNoise noise() const { return noise(sigma_t); }

@@ -102,11 +102,12 @@ TargetSection target_section_from_config(const Config& config) {
     o.init_sigmas.w = positive(s, "w", o.init_sigmas.w);
   }
   if (c.has("points")) {
-    c.check_keys("points", {"max", "init_clone_times", "max_lost_frames"});
+    c.check_keys("points", {"max", "init_clone_times", "max_lost_frames", "relinearize"});
     const Config p = c.sub("points");
     o.max_target_points = at_least(p, "max", o.max_target_points, 0);
     o.point_init_clone_times = at_least(p, "init_clone_times", o.point_init_clone_times, 2);
     o.point_max_lost_frames = at_least(p, "max_lost_frames", o.point_max_lost_frames, 1);
+    o.relinearize_points = p.get_or<bool>("relinearize", o.relinearize_points);
   }
   if (c.has("adaptive")) {
     c.check_keys("adaptive", {"window", "sigma_min", "sigma_max", "nis_max", "max_step", "hold_s", "horizon"});

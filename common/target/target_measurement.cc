@@ -5,6 +5,13 @@
 namespace vimot {
 namespace target {
 
+Eigen::Matrix<double, 3, 9> point_relinearization(const Eigen::Vector3d& p_lin, const Eigen::Vector3d& p_new) {
+  Eigen::Matrix<double, 3, 9> J = Eigen::Matrix<double, 3, 9>::Zero();
+  J.leftCols<3>() = skew(p_new - p_lin);
+  J.rightCols<3>().setIdentity();
+  return J;
+}
+
 Eigen::Vector3d target_point_in_camera(TargetRepresentation representation, const PoseValue& imu_pose,
                                        const PoseValue& target_pose, const Eigen::Vector3d& p_FinT,
                                        const CameraExtrinsics& cam) {

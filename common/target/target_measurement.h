@@ -39,6 +39,16 @@ struct TargetPointPrediction {
   Eigen::Matrix<double, 2, 3> H_point{Eigen::Matrix<double, 2, 3>::Zero()};        // p_FinT
 };
 
+/// Re-linearisation of an in-state target point whose linearisation point
+/// moves from p_lin to p_new, with its covariance carried along the target's
+/// gauge. The map J (3×9 over [δθ_T δp_T] of the target pose and the point's
+/// δp) gives the point's new error δp' = J [δθ_T; δp_T; δp] = δp + [(p_new −
+/// p_lin)×] δθ_T: it takes the rotation gauge's point rows [p_lin×]α to
+/// [p_new×]α and keeps the shift's (−t), so Jacobians at p_new annihilate
+/// the gauge the covariance holds, as the first estimate's did
+/// (StateHelper::transform_variable; docs/target_model.md).
+Eigen::Matrix<double, 3, 9> point_relinearization(const Eigen::Vector3d& p_lin, const Eigen::Vector3d& p_new);
+
 /// p_FinC of a target point (Eq. 8 or 9). imu_pose is ignored for kLocal.
 Eigen::Vector3d target_point_in_camera(TargetRepresentation representation, const PoseValue& imu_pose,
                                        const PoseValue& target_pose, const Eigen::Vector3d& p_FinT,

@@ -3,6 +3,7 @@
 #include "common/math/quat.h"
 #include "common/target/target_conversion.h"
 #include "common/target/target_measurement.h"
+#include "common/target/target_model.h"
 #include "target_test_util.h"
 
 using namespace vimot;
@@ -88,4 +89,39 @@ TEST_CASE("a point behind the camera is flagged invalid", "[target]") {
   tp.p = Eigen::Vector3d(0.0, 0.0, -2.0);
   const auto m = predict_target_point(TargetRepresentation::kLocal, PoseValue{}, tp, Eigen::Vector3d::Zero(), cam);
   CHECK_FALSE(m.valid);
+}
+
+TEST_CASE("a re-linearised point's Jacobians do not see the gauge its carried covariance holds", "[target]") {
+  const CameraExtrinsics cam = sample_camera();
+  const estimator::ImuValue imu = test::sample_imu();
+  const PoseValue pose = imu_pose(imu);
+  const TargetValue xg = target_in_front(pose, cam);
+  const Eigen::Vector3d p_lin(0.4, -0.3, 0.5);  // the first triangulation
+  const Eigen::Vector3d p_new = p_lin + Eigen::Vector3d(0.03, -0.02, 0.04);
+  const Eigen::Matrix<double, 3, 9> J = point_relinearization(p_lin, p_new);
+  CHECK(J.middleCols<3>(3).isZero(0.0));  // only the point's error changes, by the rotation error
+  CHECK(J.rightCols<3>().isIdentity(0.0));
+  for (TargetRepresentation rep : {TargetRepresentation::kGlobal, TargetRepresentation::kLocal}) {
+    INFO(to_string(rep));
+    const TargetValue x = rep == TargetRepresentation::kGlobal ? xg : global_to_local(pose, xg);
+    // The target gauge (rotation α, shift t; target_model.h): target-pose rows,
+    // and the point's rows [p×]α − t at the point it was linearised at.
+    const JointNullspace N = joint_unobservable_directions(rep, imu, x);
+    Eigen::Matrix<double, 9, 6> gauge_lin;
+    gauge_lin.topRows<6>() = N.block<6, 6>(15, 0);
+    gauge_lin.block<3, 3>(6, 0) = skew(p_lin);
+    gauge_lin.block<3, 3>(6, 3) = -Eigen::Matrix3d::Identity();
+    const TargetPointPrediction m = predict_target_point(rep, pose, x.pose(), p_new, cam);
+    REQUIRE(m.valid);
+    const auto seen = [&](const Eigen::Matrix<double, 3, 6>& point_rows) -> double {
+      return (m.H_imu_pose * N.block<6, 6>(0, 0) + m.H_target_pose * gauge_lin.topRows<6>() + m.H_point * point_rows)
+          .cwiseAbs()
+          .maxCoeff();
+    };
+    const double carried = seen(J * gauge_lin);
+    const double stale = seen(gauge_lin.bottomRows<3>());
+    INFO("carried " << carried << ", stale " << stale);
+    CHECK(carried < 1e-12 * m.H_target_pose.cwiseAbs().maxCoeff());
+    CHECK(stale > 1e-3);  // Jacobians at p_new against the first estimate's gauge: the leak
+  }
 }
