@@ -654,8 +654,15 @@ void TargetFilter::update_points(State& state, const std::vector<FeatureObservat
     // lever arm of T's orientation; moving the linearisation point with the
     // covariance carried along the gauge keeps the gauge out of the update.
     if (use_fej && options_.relinearize_points && pt.var->value() != pt.var->fej()) {
-      StateHelper::transform_variable(state, pt.var, {target_->pose(), pt.var},
-                                      point_relinearization(pt.var->fej(), pt.var->value()));
+      const Eigen::Matrix3d R_ItoT = global ? Eigen::Matrix3d(target_->pose()->Rot_fej() *
+                                                              state.imu()->pose()->Rot_fej().transpose())
+                                            : target_->pose()->Rot_fej();
+      std::vector<TypePtr> order{target_->pose()};
+      if (global) order.push_back(state.imu()->pose());
+      order.push_back(pt.var);
+      StateHelper::transform_variable(
+          state, pt.var, order,
+          point_relinearization(options_.representation, R_ItoT, pt.var->fej(), pt.var->value()));
       pt.var->set_fej(pt.var->value());
     }
     const Eigen::Vector3d p_FinT = pt.var->value();

@@ -5,9 +5,13 @@
 namespace vimot {
 namespace target {
 
-Eigen::Matrix<double, 3, 9> point_relinearization(const Eigen::Vector3d& p_lin, const Eigen::Vector3d& p_new) {
-  Eigen::Matrix<double, 3, 9> J = Eigen::Matrix<double, 3, 9>::Zero();
-  J.leftCols<3>() = skew(p_new - p_lin);
+Eigen::MatrixXd point_relinearization(TargetRepresentation representation, const Eigen::Matrix3d& R_ItoT,
+                                      const Eigen::Vector3d& p_lin, const Eigen::Vector3d& p_new) {
+  const bool global = representation == TargetRepresentation::kGlobal;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, global ? 15 : 9);
+  const Eigen::Matrix3d lever = skew(p_new - p_lin);
+  J.leftCols<3>() = lever;
+  if (global) J.middleCols<3>(6) = -lever * R_ItoT;
   J.rightCols<3>().setIdentity();
   return J;
 }

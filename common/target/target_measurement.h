@@ -40,14 +40,19 @@ struct TargetPointPrediction {
 };
 
 /// Re-linearisation of an in-state target point whose linearisation point
-/// moves from p_lin to p_new, with its covariance carried along the target's
-/// gauge. The map J (3×9 over [δθ_T δp_T] of the target pose and the point's
-/// δp) gives the point's new error δp' = J [δθ_T; δp_T; δp] = δp + [(p_new −
-/// p_lin)×] δθ_T: it takes the rotation gauge's point rows [p_lin×]α to
-/// [p_new×]α and keeps the shift's (−t), so Jacobians at p_new annihilate
-/// the gauge the covariance holds, as the first estimate's did
+/// moves from p_lin to p_new, with its covariance carried along the
+/// unobservable directions. The point's new error is
+///   δp' = δp + [(p_new − p_lin)×] δθ_TrelI,  δθ_TrelI = δθ_T − R_ItoT δθ_I
+/// (T's rotation error relative to the IMU; local: δθ_T itself), J over
+/// [δθ_T δp_T (target pose); δθ_I δp_I (IMU pose, global only); δp], 3×9
+/// local, 3×15 global. It takes the target gauge's point rows [p_lin×]α − t
+/// to [p_new×]α − t and keeps the world yaw's and position's at 0 (T and I
+/// turn together), so Jacobians at p_new annihilate the directions the
+/// covariance holds, as the first estimate's did. R_ItoT at the poses'
+/// first estimates, where the covariance holds them
 /// (StateHelper::transform_variable; docs/target_model.md).
-Eigen::Matrix<double, 3, 9> point_relinearization(const Eigen::Vector3d& p_lin, const Eigen::Vector3d& p_new);
+Eigen::MatrixXd point_relinearization(TargetRepresentation representation, const Eigen::Matrix3d& R_ItoT,
+                                      const Eigen::Vector3d& p_lin, const Eigen::Vector3d& p_new);
 
 /// p_FinC of a target point (Eq. 8 or 9). imu_pose is ignored for kLocal.
 Eigen::Vector3d target_point_in_camera(TargetRepresentation representation, const PoseValue& imu_pose,
