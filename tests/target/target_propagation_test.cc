@@ -6,8 +6,8 @@
 #include "common/estimator/propagator.h"
 #include "common/math/quat.h"
 #include "common/target/target_conversion.h"
-#include "common/target/target_measurement.h"
 #include "common/target/target_filter.h"
+#include "common/target/target_measurement.h"
 #include "common/target/target_model.h"
 #include "target_test_util.h"
 
