@@ -100,7 +100,8 @@ int run(int argc, const char* const* argv) {
   Stage segment{"segmenter, 2 images", {}}, mask{"mask filter, 2 masks", {}}, track{"feature tracker", {}};
   Stage update{"VIO + target filter: camera update", {}}, propagate{"VIO + target filter: IMU propagation", {}};
   GroundTruth truth;
-  bool target_seen = false, frame_known = false;
+  bool target_seen = false;
+  int32_t frame_start = 0;  // the filter's start whose frame X is
   eval::TargetFrameTransform X;
   eval::TrajectoryErrors target_errors;
   double iou_sum = 0.0;
@@ -152,8 +153,8 @@ int run(int argc, const char* const* argv) {
         if (filter.initialized() && truth.utime == simulated.utime && truth.has_target && target_seen &&
             st == estimator::FrameStatus::kProcessed) {
           const target::TargetValue x = filter.value();
-          if (!frame_known) X = eval::target_frame_transform(truth, x.q_RtoT, x.p_TinR);
-          frame_known = true;
+          if (filter.starts() != frame_start) X = eval::target_frame_transform(truth, x.q_RtoT, x.p_TinR);
+          frame_start = filter.starts();
           const eval::TargetInImu ti = eval::true_target_in_imu(eval::in_target_frame(truth, X));
           const target::Matrix12d P = filter.covariance();
           target_errors.add(eval::compute_error(simulated.utime, ti.q_ItoT, ti.p_TinI, x.q_RtoT, x.p_TinR,

@@ -228,6 +228,7 @@ std::string target_summary_json(const std::vector<TargetCell>& cells, const std:
           j.field("adaptive_violations", ts.adaptive_violations);
           j.field("adaptive_sigma_mean", ts.adaptive_sigma_sum / static_cast<double>(ts.adaptive_frames));
           j.field("adaptive_sigma_last", ts.adaptive_sigma_last);
+          j.field("target_restarts", ts.target_restarts);
         }
         j.end_object();
       }

@@ -70,12 +70,18 @@ TargetMatch TruthMatcher::match_targets(TargetMatchCounts* counts, bool own_fram
   TargetMatch out;
   bool take_frame = own_frame;
   int64_t previous_utime = -1;
+  int previous_start = -1;
   for (const auto& [utime, est] : targets_) {
-    if (own_frame && restart_gap_us > 0 && previous_utime >= 0 && utime - previous_utime > restart_gap_us) {
+    // A new target frame: the filter started the target again, or (a process
+    // restart without checkpoint) its states stopped for longer than the gap.
+    const bool restarted = previous_utime >= 0 && ((restart_gap_us > 0 && utime - previous_utime > restart_gap_us) ||
+                                                   est.start_count != previous_start);
+    if (own_frame && restarted) {
       take_frame = true;
       ++out.frame_restarts;
     }
     previous_utime = utime;
+    previous_start = est.start_count;
     const auto it = truths_.find(utime);
     if (it == truths_.end() || !it->second.has_target) {
       ++c.unmatched;

@@ -47,7 +47,7 @@ struct TargetMatch {
   /// The filter's target frame in the true one (identity unless own_frame;
   /// the last one taken).
   TargetFrameTransform target_frame;
-  /// Times the frame was taken again after a restart gap.
+  /// Times the frame was taken again (start_count changed, or a restart gap).
   int64_t frame_restarts{0};
 };
 
@@ -61,10 +61,10 @@ class TruthMatcher {
   std::vector<ErrorSample> match(MatchCounts* counts) const;
   /// own_frame: the filter defined its own target frame (init mode
   /// features); the truth is taken in it, through the fixed transform at the
-  /// first matched target state (target_frame.h). restart_gap_us > 0 (with
-  /// own_frame): target states more than this apart mean the filter started
-  /// its target again (a respawned process, a reset), in a new frame of its
-  /// own, which is taken at the first matched state after the gap.
+  /// first matched target state (target_frame.h). The frame is taken again at
+  /// the first matched state after a new start: the state's start_count
+  /// changed (the filter started the target again), or, restart_gap_us > 0,
+  /// target states more than this apart (a respawned process, a reset).
   TargetMatch match_targets(TargetMatchCounts* counts, bool own_frame = false, int64_t restart_gap_us = 0) const;
 
  private:

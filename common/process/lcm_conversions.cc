@@ -205,6 +205,7 @@ target_state_t to_lcm(const TargetStateEstimate& s) {
   write<3>(s.w_TinT, msg.w_TinT);
   write_matrix<12>(s.covariance, msg.covariance);
   msg.num_target_points = s.num_target_points;
+  msg.start_count = s.start_count;
   return msg;
 }
 
@@ -230,6 +231,10 @@ TargetStateEstimate from_lcm(const target_state_t& msg) {
                                 std::to_string(msg.num_target_points));
   }
   s.num_target_points = msg.num_target_points;
+  if (msg.start_count < 0) {
+    throw std::invalid_argument("target_state_t: negative start_count " + std::to_string(msg.start_count));
+  }
+  s.start_count = msg.start_count;
   return s;
 }
 

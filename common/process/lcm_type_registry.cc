@@ -171,7 +171,8 @@ const std::vector<LcmTypeInfo>& vimot_lcm_types() {
       {"v_TinT", LcmKind::kDouble, "3"},
       {"w_TinT", LcmKind::kDouble, "3"},
       {"covariance", LcmKind::kDouble, "144"},
-      {"num_target_points", LcmKind::kInt32}}};
+      {"num_target_points", LcmKind::kInt32},
+      {"start_count", LcmKind::kInt32}}};
 
   // Top-level messages only: nested types (feature_obs_t, image_metadata_t)
   // are never published on their own.

@@ -61,6 +61,8 @@ std::string TargetCheckpoint::save() const {
   w.put(static_cast<int32_t>(o.mode));
   w.put(static_cast<uint8_t>(o.planar));
   w.put(filter_.frame_count());
+  w.put(filter_.starts());
+  w.put(static_cast<uint8_t>(filter_.model_verified()));
   w.put(static_cast<int64_t>(filter_.points().size()));
   for (const auto& [id, point] : filter_.points()) {
     w.put(id);
@@ -89,6 +91,8 @@ bool TargetCheckpoint::load(
     return false;
   }
   const int64_t frame = r.take<int64_t>();
+  const int32_t starts = r.take<int32_t>();
+  const bool model_verified = r.take<uint8_t>() != 0;
   const int64_t n_points = r.take<int64_t>();
   std::map<int64_t, int64_t> last_updated;
   for (int64_t i = 0; r.ok() && i < n_points; ++i) {
@@ -121,12 +125,13 @@ bool TargetCheckpoint::load(
       points[v->key] = TargetPoint{std::dynamic_pointer_cast<estimator::Vec>(var), it->second};
     }
   }
-  if (points.size() != last_updated.size() || (!target && (!clones.empty() || !points.empty()))) {
+  if (points.size() != last_updated.size() || (!target && (!clones.empty() || !points.empty())) || starts < 0 ||
+      (target && starts == 0)) {
     *why = "its target variables do not match its bookkeeping";
     return false;
   }
   filter_.restore(std::move(target), std::move(clones), std::move(points), std::move(tracks), frame,
-                  std::move(adaptive));
+                  std::move(adaptive), starts, model_verified);
   return true;
 }
 

@@ -174,6 +174,8 @@ void TargetFilter::reset() {
   feature_init_info_.reset();
   init_window_.clear();
   frame_ = 0;
+  starts_ = 0;
+  model_verified_ = false;
   predicted_.reset();
   if (adaptive_) {
     adaptive_.emplace(options_.adaptive, options_.sigma_t);
@@ -183,13 +185,15 @@ void TargetFilter::reset() {
 
 void TargetFilter::restore(std::shared_ptr<TargetState> target, std::map<int64_t, std::shared_ptr<PoseJPL>> clones,
                            std::map<int64_t, TargetPoint> points, estimator::FeatureDatabase tracks, int64_t frame,
-                           std::optional<AdaptiveNoise> adaptive) {
+                           std::optional<AdaptiveNoise> adaptive, int32_t starts, bool model_verified) {
   reset();
   target_ = std::move(target);
   clones_ = std::move(clones);
   points_ = std::move(points);
   tracks_ = std::move(tracks);
   frame_ = frame;
+  starts_ = starts;
+  model_verified_ = model_verified;
   if (adaptive_ && adaptive) {
     adaptive_ = std::move(adaptive);
     noise_ = options_.noise(adaptive_->sigma());
@@ -370,6 +374,7 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
 
 void TargetFilter::add_target(State& state, int64_t utime, const TargetValue& x, const Matrix12d& P_TT,
                               const Eigen::MatrixXd& P_Tx) {
+  ++starts_;
   target_ = std::make_shared<TargetState>();
   target_->set_value(x.to_vector());
   target_->set_fej(x.to_vector());
@@ -578,6 +583,32 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
   for (const auto& f : use) tracks_.remove(f->feature_id);
   update_tracks(state, std::move(use));
   end_adaptive_frame(state);
+  if (adaptive_ && !model_verified_ && adaptive_->consistent()) {
+    model_verified_ = true;
+    // The target's frame and points were made under a σ that its own
+    // measurements rejected: an error made then along its gauge (where its
+    // origin sits among its points) no later measurement can see. Now that
+    // σ is verified, the target starts again from its features under it.
+    if (options_.adaptive.restart && adaptive_->violations() > 0 &&
+        options_.init_mode == TargetInitMode::kFeatures) {
+      restart_target(state);
+    }
+  }
+}
+
+void TargetFilter::restart_target(State& state) {
+  for (const auto& kv : clones_) StateHelper::marginalize(state, kv.second);
+  for (const auto& kv : points_) StateHelper::marginalize(state, kv.second.var);
+  StateHelper::marginalize(state, target_);
+  target_.reset();
+  clones_.clear();
+  points_.clear();
+  pending_.reset();
+  tracks_.clear();
+  feature_init_info_.reset();
+  init_window_.clear();
+  predicted_.reset();
+  ++stats_.target_restarts;
 }
 
 estimator::ClonePoses TargetFilter::poses_in_target(const State& state, std::set<int64_t>* times) const {

@@ -206,6 +206,7 @@ struct TargetUpdateStats {
   int64_t adaptive_violations{0};
   double adaptive_sigma_sum{0.0};
   double adaptive_sigma_last{0.0};
+  int64_t target_restarts{0};  // kAdaptive with adaptive.restart: target started again
   double residual_sum{0.0};
   double residual_sq_sum{0.0};
   int64_t residual_count{0};
@@ -234,6 +235,11 @@ class TargetFilter : public estimator::VioExtension {
 
   const TargetFilterOptions& options() const { return options_; }
   bool initialized() const { return static_cast<bool>(target_); }
+  /// How many times the target was started (0 before the first start). A
+  /// change means a new target frame: a transform to it must be taken again.
+  int32_t starts() const { return starts_; }
+  /// kAdaptive: whether the model has been judged consistent at least once.
+  bool model_verified() const { return model_verified_; }
   /// The target variable (nullptr before initialisation).
   const std::shared_ptr<TargetState>& target() const { return target_; }
   const std::map<int64_t, std::shared_ptr<estimator::PoseJPL>>& clones() const { return clones_; }
@@ -258,7 +264,7 @@ class TargetFilter : public estimator::VioExtension {
   /// count and σ_t estimate (kAdaptive); what lives within a frame is cleared.
   void restore(std::shared_ptr<TargetState> target, std::map<int64_t, std::shared_ptr<estimator::PoseJPL>> clones,
                std::map<int64_t, TargetPoint> points, estimator::FeatureDatabase tracks, int64_t frame,
-               std::optional<AdaptiveNoise> adaptive);
+               std::optional<AdaptiveNoise> adaptive, int32_t starts, bool model_verified);
   /// Whether target updates now change the robot (kEkf, or kAdaptive judged consistent).
   bool tightly_coupled() const;
 
@@ -297,6 +303,9 @@ class TargetFilter : public estimator::VioExtension {
   void update_points(estimator::State& state, const std::vector<FeatureObservation>& obs);
   void initialize_points(estimator::State& state, int64_t utime);
   void marginalize_point(estimator::State& state, int64_t feature_id);
+  // Removes the target, its clones and points from the state and forgets its
+  // tracks; the features start begins again at the next frame.
+  void restart_target(estimator::State& state);
   // IMU pose at each IMU+target clone time in T; `times` gets those times.
   estimator::ClonePoses poses_in_target(const estimator::State& state, std::set<int64_t>* times) const;
   // Every variable but the target, its clones and the target points.
@@ -334,6 +343,8 @@ class TargetFilter : public estimator::VioExtension {
   TargetUpdateStats stats_;
   std::map<int64_t, TargetPoint> points_;
   int64_t frame_{0};
+  int32_t starts_{0};
+  bool model_verified_{false};
   std::optional<AdaptiveNoise> adaptive_;
   // kAdaptive: driven components' values and covariance after this frame's
   // propagation, and its length (s).

@@ -110,7 +110,7 @@ TargetSection target_section_from_config(const Config& config) {
     o.relinearize_points = p.get_or<bool>("relinearize", o.relinearize_points);
   }
   if (c.has("adaptive")) {
-    c.check_keys("adaptive", {"window", "sigma_min", "sigma_max", "nis_max", "max_step", "hold_s", "horizon"});
+    c.check_keys("adaptive", {"window", "sigma_min", "sigma_max", "nis_max", "max_step", "hold_s", "horizon", "restart"});
     const Config a = c.sub("adaptive");
     AdaptiveNoiseOptions& ad = o.adaptive;
     ad.window = at_least(a, "window", ad.window, 2);
@@ -120,6 +120,7 @@ TargetSection target_section_from_config(const Config& config) {
     ad.max_step = positive(a, "max_step", ad.max_step);
     ad.hold_s = non_negative(a, "hold_s", ad.hold_s);
     ad.horizon = at_least(a, "horizon", ad.horizon, 1);
+    ad.restart = a.get_or<bool>("restart", ad.restart);
     if (ad.horizon > ad.window) a.fail("horizon", "must be <= window (" + std::to_string(ad.window) + ")");
     if (!(ad.sigma_max >= ad.sigma_min)) a.fail("sigma_max", "must be >= sigma_min");
     if (!(ad.nis_max > 1.0)) a.fail("nis_max", "must be > 1, got " + std::to_string(ad.nis_max));

@@ -8,11 +8,13 @@ namespace vimot {
 namespace target {
 
 TargetStateEstimate target_state_estimate(int64_t utime, TargetRepresentation representation, const TargetValue& x,
-                                          const Matrix12d& P, const PoseValue& imu_pose, int num_target_points) {
+                                          const Matrix12d& P, const PoseValue& imu_pose, int num_target_points,
+                                          int start_count) {
   TargetStateEstimate s;
   s.utime = utime;
   s.covariance = P;
   s.num_target_points = num_target_points;
+  s.start_count = start_count;
   TargetValue local, global;
   if (representation == TargetRepresentation::kLocal) {
     s.representation = TargetFrame::kLocal;

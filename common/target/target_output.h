@@ -17,7 +17,8 @@ namespace target {
 
 /// x (in `representation`) with covariance P at utime; imu_pose = [q_GtoI, p_IinG] at utime.
 TargetStateEstimate target_state_estimate(int64_t utime, TargetRepresentation representation, const TargetValue& x,
-                                          const Matrix12d& P, const PoseValue& imu_pose, int num_target_points);
+                                          const Matrix12d& P, const PoseValue& imu_pose, int num_target_points,
+                                          int start_count);
 
 /// A global prediction made at utime for utime + horizon_s.
 TargetPosePrediction target_pose_prediction(int64_t utime, double horizon_s, const TargetPrediction& prediction,

@@ -26,6 +26,8 @@ struct TargetStateEstimate {
   /// [δθ_T, δp_T, δv, δw] in `representation` (see the .lcm file).
   Eigen::Matrix<double, 12, 12> covariance{Eigen::Matrix<double, 12, 12>::Zero()};
   int num_target_points{0};
+  /// Times the filter started the target (a change: a new target frame).
+  int start_count{0};
 };
 
 struct TargetPosePrediction {

@@ -148,12 +148,13 @@ int run(int argc, const char* const* argv) {
     std::printf("target kept: %lld of %lld updated states from the first target state on have one\n",
                 static_cast<long long>(r.frames_with_target), static_cast<long long>(r.frames_since_target_start));
     if (opt.target_own_frame) {
-      std::printf("target frame (filter's in the true one, fixed at its first state): %s\n",
+      std::printf("target frame (filter's in the true one, taken at its first state and at each new start; the "
+                  "last): %s\n",
                   r.target_samples.target_frame.describe().c_str());
-      if (opt.target_restart_gap_s > 0.0) {
-        std::printf("target restarts (gaps above %.3g s): %lld, the frame taken again at each\n",
-                    opt.target_restart_gap_s, static_cast<long long>(r.target_samples.frame_restarts));
-      }
+      std::printf("target started again (start_count changed");
+      if (opt.target_restart_gap_s > 0.0) std::printf(", or gaps above %.3g s", opt.target_restart_gap_s);
+      std::printf("): %lld times, the frame taken again at each\n",
+                  static_cast<long long>(r.target_samples.frame_restarts));
     }
     for (const auto& [name, ts] : {std::pair<const char*, const eval::ErrorSummary&>{"in IMU  ", r.target_in_imu},
                                    std::pair<const char*, const eval::ErrorSummary&>{"in world", r.target_in_world}}) {

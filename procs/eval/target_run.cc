@@ -51,6 +51,7 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
   std::map<int64_t, bool> target_obs;     // frames given to the node: with target observations?
   std::optional<int64_t> first_target_utime;  // of the first frame given with target observations
   int64_t gap = 0;
+  int32_t frame_start = 0;  // the filter's start whose frame r.target_frame is
   int64_t used_before = 0;  // the filter's obs_used after the previous processed frame
   SimPipeline* pipeline = nullptr;
   const TargetFilterNode* node_ptr = nullptr;
@@ -110,8 +111,10 @@ TargetRunResult run_target_on_sim(const sim::SimConfig& sim_config, const estima
           x_i = target::global_to_local(ip, x);
           P_i = target::global_to_local_covariance(ip, x, P18);
         }
-        // A frame of the filter's own (features start): fixed at its first estimate.
-        if (e_ti.count() == 0 && filter->options().init_mode == target::TargetInitMode::kFeatures) {
+        // A frame of the filter's own (features start): fixed at its first
+        // estimate, taken again when the filter starts the target again.
+        if (filter->starts() != frame_start && filter->options().init_mode == target::TargetInitMode::kFeatures) {
+          frame_start = filter->starts();
           r.target_frame = target_frame_transform(truth, x_i.q_RtoT, x_i.p_TinR);
         }
         const GroundTruth t = in_target_frame(truth, r.target_frame);

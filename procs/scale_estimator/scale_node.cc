@@ -240,7 +240,7 @@ void ScaleNode::filter_pose(const NavState& state, const CameraPoseInWorld& came
   if (!on_object_state_) return;
   const target::PoseValue imu{state.q_GtoI, state.p_IinG};
   on_object_state_(target::target_state_estimate(filter_.utime(), target::TargetRepresentation::kGlobal,
-                                                 filter_.value(), filter_.covariance(), imu, 0),
+                                                 filter_.value(), filter_.covariance(), imu, 0, 1),
                    target::target_pose_prediction(filter_.utime(), options_.prediction_horizon_s,
                                                   filter_.predict(options_.prediction_horizon_s), imu));
 }

@@ -46,7 +46,7 @@ TargetFilterNodeOptions node_options_from_config(const Config& cfg) {
 TargetStateEstimate target_state_of(const estimator::VioEstimator& estimator, const target::TargetFilter& filter) {
   return target::target_state_estimate(estimator.state_utime(), filter.options().representation, filter.value(),
                                        filter.covariance(), target::imu_pose(estimator.imu_value()),
-                                       static_cast<int>(filter.points().size()));
+                                       static_cast<int>(filter.points().size()), filter.starts());
 }
 
 TargetPosePrediction target_prediction_of(const estimator::VioEstimator& estimator,

@@ -126,3 +126,43 @@ TEST_CASE("target restarts: the frame is taken again after a gap in the target s
   CHECK(once.target_in_world.front().err_p.norm() < 1e-9);
   CHECK(once.target_in_world.back().err_p.norm() > 0.1);
 }
+
+// The target filter started its target again (adaptive.restart) in the same
+// process: no gap, but a new start_count, and the matcher takes the frame
+// again at the first state of the new start.
+TEST_CASE("target restarts: the frame is taken again when start_count changes", "[eval][target]") {
+  const auto estimate = [](double t, const TargetFrameTransform& X, int start_count) {
+    const GroundTruth g = in_target_frame(truth_at(t), X);
+    const TargetInImu ti = true_target_in_imu(g);
+    TargetStateEstimate e;
+    e.utime = g.utime;
+    e.q_ItoT = ti.q_ItoT;
+    e.p_TinI = ti.p_TinI;
+    e.q_GtoT = g.q_GtoT;
+    e.p_TinG = g.p_TinG;
+    e.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
+    e.start_count = start_count;
+    return e;
+  };
+  TargetFrameTransform first, second;
+  first.q_TtoTest = rot_to_quat(exp_so3(Eigen::Vector3d(0.0, 0.0, 0.4)));
+  first.p_TestInT = Eigen::Vector3d(0.1, 0.2, -0.1);
+  second.q_TtoTest = rot_to_quat(exp_so3(Eigen::Vector3d(0.0, 0.0, 0.45)));
+  second.p_TestInT = Eigen::Vector3d(0.15, 0.2, -0.1);  // 5 cm from the first, along x
+  TruthMatcher matcher;
+  for (int k = 0; k <= 40; ++k) {
+    matcher.add_truth(truth_at(0.1 * k));
+    matcher.add_target(k <= 20 ? estimate(0.1 * k, first, 1) : estimate(0.1 * k, second, 2));
+  }
+  TargetMatchCounts counts;
+  // A gap bound far above the 0.1 s between states: only start_count tells.
+  const TargetMatch m = matcher.match_targets(&counts, /*own_frame=*/true, /*restart_gap_us=*/500000);
+  REQUIRE(counts.matched == 41);
+  CHECK(m.frame_restarts == 1);
+  CHECK(orientation_error(m.target_frame.q_TtoTest, second.q_TtoTest).norm() < 1e-9);
+  CHECK((m.target_frame.p_TestInT - second.p_TestInT).norm() < 1e-9);
+  for (const ErrorSample& e : m.target_in_imu) {
+    CHECK(e.err_p.norm() < 1e-9);
+    CHECK(e.err_theta.norm() < 1e-9);
+  }
+}

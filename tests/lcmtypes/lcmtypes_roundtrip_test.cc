@@ -132,6 +132,7 @@ TEST_CASE("target_state_t round-trips") {
   CHECK(vec(r.w_TinT) == vec(s.w_TinT));
   CHECK(vec(r.covariance) == vec(s.covariance));
   CHECK(r.num_target_points == s.num_target_points);
+  CHECK(r.start_count == s.start_count);
   CHECK(encode(r) == encode(s));
 }
 

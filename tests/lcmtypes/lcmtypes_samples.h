@@ -151,6 +151,7 @@ inline vimot::target_state_t sample_target_state() {
   d.fill(m.w_TinT);
   d.fill(m.covariance);
   m.num_target_points = d.i32();
+  m.start_count = d.i32();
   return m;
 }
 

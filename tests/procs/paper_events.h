@@ -16,9 +16,9 @@ namespace vimot {
 
 inline std::string source_path(const std::string& relative) { return std::string(VIMOT_SOURCE_DIR) + "/" + relative; }
 
-/// All events of `duration` s of config/sim_paper.yaml with noise seed 5.
-inline std::vector<sim::SimEvent> simulate(double duration) {
-  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
+/// All events of `duration` s of a simulator config (default the paper's) with noise seed 5.
+inline std::vector<sim::SimEvent> simulate(double duration, const std::string& config = "config/sim_paper.yaml") {
+  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path(config)));
   cfg.seed = 5;
   cfg.duration = duration;
   cfg.ground_truth_events = true;

@@ -5,7 +5,9 @@
 // start; on the rc_car target (stops and speed changes beyond any small
 // random walk) started at σ_t = 0.001, where the fixed-σ_t filter loses the
 // target (docs/evaluation.md), the check trips, σ̂ rises far above the
-// start and the target is kept.
+// start and the target is kept. The shipped restart (adaptive.restart):
+// the target is started again exactly once, when the model is first judged
+// consistent, and only if a violation came before.
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -55,6 +57,7 @@ TEST_CASE("adaptive mode: no violation on a right model, tight coupling after th
                  << s.adaptive_sigma_last);
   REQUIRE_FALSE(r.diverged);
   CHECK(s.adaptive_violations == 0);
+  CHECK(s.target_restarts == 0);  // consistent, but no violation before: the start was made under a right σ
   const int window = target::AdaptiveNoiseOptions{}.window;
   CHECK(s.adaptive_coupled_frames == s.adaptive_frames - (window - 1));
   CHECK(s.adaptive_sigma_last < 0.05);
@@ -65,10 +68,13 @@ TEST_CASE("adaptive mode: a model violation trips the check and raises σ̂", "[
   const target::TargetUpdateStats& s = r.target_stats;
   const double sigma_mean = s.adaptive_sigma_sum / s.adaptive_frames;
   INFO("frames " << s.adaptive_frames << ", coupled " << s.adaptive_coupled_frames << ", violations "
-                 << s.adaptive_violations << ", σ̂ mean " << sigma_mean << ", max target error "
+                 << s.adaptive_violations << ", restarts " << s.target_restarts << ", σ̂ mean " << sigma_mean
+                 << ", max target error "
                  << r.target_max_error_m << " m");
   REQUIRE_FALSE(r.diverged);
   CHECK(s.adaptive_violations >= 1);
+  REQUIRE(s.adaptive_coupled_frames > 0);  // judged consistent within the run
+  CHECK(s.target_restarts == 1);            // then started again, once
   CHECK(sigma_mean > 50 * 0.001);
   CHECK(r.target_max_error_m < 1.0);  // fixed σ_t 0.001: lost (tens of m)
 }
