@@ -32,6 +32,21 @@ GroundTruth truth_at(double t) {
   return g;
 }
 
+
+// The estimate of a filter whose frame is T ∘ X, exact: the truth seen in that frame.
+TargetStateEstimate exact_estimate(double t, const TargetFrameTransform& X, int start_count = 0) {
+  const GroundTruth g = in_target_frame(truth_at(t), X);
+  const TargetInImu ti = true_target_in_imu(g);
+  TargetStateEstimate e;
+  e.utime = g.utime;
+  e.q_ItoT = ti.q_ItoT;
+  e.p_TinI = ti.p_TinI;
+  e.q_GtoT = g.q_GtoT;
+  e.p_TinG = g.p_TinG;
+  e.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
+  e.start_count = start_count;
+  return e;
+}
 }  // namespace
 
 TEST_CASE("target frame transform: the filter's frame at the start, the same body frame later", "[eval][target]") {
@@ -88,19 +103,6 @@ TEST_CASE("target frame transform: identity leaves the truth untouched", "[eval]
 // A target filter that restarts (a respawned process) defines a new frame of
 // its own: with a restart gap the matcher takes the frame again after it.
 TEST_CASE("target restarts: the frame is taken again after a gap in the target states", "[eval][target]") {
-  // The filter's estimate of frame T ∘ X is exact: the truth seen in that frame.
-  const auto estimate = [](double t, const TargetFrameTransform& X) {
-    const GroundTruth g = in_target_frame(truth_at(t), X);
-    const TargetInImu ti = true_target_in_imu(g);
-    TargetStateEstimate e;
-    e.utime = g.utime;
-    e.q_ItoT = ti.q_ItoT;
-    e.p_TinI = ti.p_TinI;
-    e.q_GtoT = g.q_GtoT;
-    e.p_TinG = g.p_TinG;
-    e.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
-    return e;
-  };
   TargetFrameTransform first, second;
   first.q_TtoTest = rot_to_quat(exp_so3(Eigen::Vector3d(0.0, 0.0, 0.7)));
   first.p_TestInT = Eigen::Vector3d(0.2, -0.1, 0.3);
@@ -108,8 +110,8 @@ TEST_CASE("target restarts: the frame is taken again after a gap in the target s
   second.p_TestInT = Eigen::Vector3d(-0.3, 0.4, 0.0);
   TruthMatcher matcher;
   for (int k = 0; k <= 40; ++k) matcher.add_truth(truth_at(0.1 * k));
-  for (int k = 0; k <= 10; ++k) matcher.add_target(estimate(0.1 * k, first));   // 0 .. 1 s
-  for (int k = 25; k <= 40; ++k) matcher.add_target(estimate(0.1 * k, second)); // after a 1.5 s gap
+  for (int k = 0; k <= 10; ++k) matcher.add_target(exact_estimate(0.1 * k, first));   // 0 .. 1 s
+  for (int k = 25; k <= 40; ++k) matcher.add_target(exact_estimate(0.1 * k, second)); // after a 1.5 s gap
 
   TargetMatchCounts counts;
   const TargetMatch again = matcher.match_targets(&counts, /*own_frame=*/true, /*restart_gap_us=*/500000);
@@ -131,19 +133,6 @@ TEST_CASE("target restarts: the frame is taken again after a gap in the target s
 // process: no gap, but a new start_count, and the matcher takes the frame
 // again at the first state of the new start.
 TEST_CASE("target restarts: the frame is taken again when start_count changes", "[eval][target]") {
-  const auto estimate = [](double t, const TargetFrameTransform& X, int start_count) {
-    const GroundTruth g = in_target_frame(truth_at(t), X);
-    const TargetInImu ti = true_target_in_imu(g);
-    TargetStateEstimate e;
-    e.utime = g.utime;
-    e.q_ItoT = ti.q_ItoT;
-    e.p_TinI = ti.p_TinI;
-    e.q_GtoT = g.q_GtoT;
-    e.p_TinG = g.p_TinG;
-    e.covariance = Eigen::Matrix<double, 12, 12>::Identity() * 1e-4;
-    e.start_count = start_count;
-    return e;
-  };
   TargetFrameTransform first, second;
   first.q_TtoTest = rot_to_quat(exp_so3(Eigen::Vector3d(0.0, 0.0, 0.4)));
   first.p_TestInT = Eigen::Vector3d(0.1, 0.2, -0.1);
@@ -152,7 +141,7 @@ TEST_CASE("target restarts: the frame is taken again when start_count changes", 
   TruthMatcher matcher;
   for (int k = 0; k <= 40; ++k) {
     matcher.add_truth(truth_at(0.1 * k));
-    matcher.add_target(k <= 20 ? estimate(0.1 * k, first, 1) : estimate(0.1 * k, second, 2));
+    matcher.add_target(k <= 20 ? exact_estimate(0.1 * k, first, 1) : exact_estimate(0.1 * k, second, 2));
   }
   TargetMatchCounts counts;
   // A gap bound far above the 0.1 s between states: only start_count tells.

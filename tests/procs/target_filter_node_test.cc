@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <map>
+#include <string>
 #include <utility>
 #include <variant>
 
@@ -69,6 +70,44 @@ std::vector<NavState> run_vins(const std::vector<sim::SimEvent>& events, const T
       options, [&](const NavState& s) { if (s.updated) updated.push_back(s); }, [](const NodeEvent&) {});
   feed(node, events);
   return updated;
+}
+
+// The events with only the first ground truth kept (the robot's start, as
+// vins' simulation start); every truth goes to `matcher` for the evaluation.
+std::vector<sim::SimEvent> robot_start_only(const std::vector<sim::SimEvent>& all, eval::TruthMatcher* matcher) {
+  std::vector<sim::SimEvent> events;
+  bool robot_start_given = false;
+  for (const auto& e : all) {
+    if (const auto* gt = std::get_if<GroundTruth>(&e)) {
+      matcher->add_truth(*gt);
+      if (robot_start_given) continue;
+      robot_start_given = true;
+    }
+    events.push_back(e);
+  }
+  return events;
+}
+
+// The offline evaluator (vimot-target-eval's run) on the same simulation
+// (simulate()'s seed) gives the node's matched figures and the same last
+// transform to the true frame: "LCM = offline" for a frame of the filter's own.
+eval::TargetRunResult check_equals_offline(const std::string& sim_config, double duration,
+                                           const TargetFilterNodeOptions& options, const eval::TargetMatch& m) {
+  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path(sim_config)));
+  cfg.seed = 5;
+  cfg.duration = duration;
+  const eval::TargetRunResult offline =
+      eval::run_target_on_sim(cfg, options.vio, options.target, options.perturb_seed);
+  REQUIRE_FALSE(offline.diverged);
+  eval::TrajectoryErrors node_errors;
+  for (const eval::ErrorSample& e : m.target_in_imu) node_errors.add(e);
+  const eval::ErrorSummary node_summary = node_errors.summary();
+  CHECK(offline.target_in_imu.count == node_summary.count);
+  CHECK(offline.target_in_imu.rmse_position_m == Approx(node_summary.rmse_position_m).epsilon(1e-9));
+  CHECK(offline.target_in_imu.rmse_orientation_deg == Approx(node_summary.rmse_orientation_deg).epsilon(1e-9));
+  CHECK(offline.target_in_imu.nees_position == Approx(node_summary.nees_position).epsilon(1e-9));
+  CHECK((offline.target_frame.p_TestInT - m.target_frame.p_TestInT).norm() < 1e-12);
+  return offline;
 }
 
 double max_nav_difference(const std::vector<NavState>& a, const std::vector<NavState>& b) {
@@ -223,18 +262,8 @@ TEST_CASE("target filter node starts the target from its features without ground
   // evaluate, in the filter's own target frame (vimot-log-eval's matching).
   const TargetFilterNodeOptions options = shipped_options();
   REQUIRE(options.target.init_mode == target::TargetInitMode::kFeatures);
-  const std::vector<sim::SimEvent> all = simulate(6.0);
-  std::vector<sim::SimEvent> events;
   eval::TruthMatcher matcher;
-  bool robot_start_given = false;
-  for (const auto& e : all) {
-    if (const auto* gt = std::get_if<GroundTruth>(&e)) {
-      matcher.add_truth(*gt);
-      if (robot_start_given) continue;
-      robot_start_given = true;
-    }
-    events.push_back(e);
-  }
+  const std::vector<sim::SimEvent> events = robot_start_only(simulate(6.0), &matcher);
   const Outputs out = run_node(events, options);
   REQUIRE(out.target.size() >= 40);
   for (const TargetStateEstimate& s : out.target) matcher.add_target(s);
@@ -254,20 +283,7 @@ TEST_CASE("target filter node starts the target from its features without ground
   // The offline evaluator (vimot-target-eval's run, same seeds, same start)
   // gives the same figures and the same transform: "LCM = offline" holds for
   // the features start too.
-  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper.yaml")));
-  cfg.seed = 5;  // simulate()'s
-  cfg.duration = 6.0;
-  const eval::TargetRunResult offline =
-      eval::run_target_on_sim(cfg, options.vio, options.target, options.perturb_seed);
-  REQUIRE_FALSE(offline.diverged);
-  eval::TrajectoryErrors node_errors;
-  for (const eval::ErrorSample& e : m.target_in_imu) node_errors.add(e);
-  const eval::ErrorSummary node_summary = node_errors.summary();
-  CHECK(offline.target_in_imu.count == node_summary.count);
-  CHECK(offline.target_in_imu.rmse_position_m == Approx(node_summary.rmse_position_m).epsilon(1e-9));
-  CHECK(offline.target_in_imu.rmse_orientation_deg == Approx(node_summary.rmse_orientation_deg).epsilon(1e-9));
-  CHECK(offline.target_in_imu.nees_position == Approx(node_summary.nees_position).epsilon(1e-9));
-  CHECK((offline.target_frame.p_TestInT - m.target_frame.p_TestInT).norm() < 1e-12);
+  check_equals_offline("config/sim_paper.yaml", 6.0, options, m);
 }
 
 TEST_CASE("target filter node: a target started again is matched in its new frame, as offline", "[target_filter]") {
@@ -281,18 +297,9 @@ TEST_CASE("target filter node: a target started again is matched in its new fram
   options.target.mode = target::TargetUpdateMode::kAdaptive;
   options.target.sigma_t = 0.001;
   const double duration = 20.0;
-  const std::vector<sim::SimEvent> all = simulate(duration, "config/sim_paper_rc_car.yaml");
-  std::vector<sim::SimEvent> events;
   eval::TruthMatcher matcher;
-  bool robot_start_given = false;
-  for (const auto& e : all) {
-    if (const auto* gt = std::get_if<GroundTruth>(&e)) {
-      matcher.add_truth(*gt);
-      if (robot_start_given) continue;
-      robot_start_given = true;
-    }
-    events.push_back(e);
-  }
+  const std::vector<sim::SimEvent> events =
+      robot_start_only(simulate(duration, "config/sim_paper_rc_car.yaml"), &matcher);
   const Outputs out = run_node(events, options);
   REQUIRE(out.target.size() >= 100);
   int changes = 0;
@@ -312,18 +319,6 @@ TEST_CASE("target filter node: a target started again is matched in its new fram
   INFO("p_TinI error " << last.err_p.transpose() << ", sigma " << P.diagonal().cwiseSqrt().transpose());
   for (int k = 0; k < 3; ++k) CHECK(std::abs(last.err_p(k)) < 3.0 * std::sqrt(P(k, k)));
 
-  sim::SimConfig cfg = sim::from_config(Config::load_file(source_path("config/sim_paper_rc_car.yaml")));
-  cfg.seed = 5;  // simulate()'s
-  cfg.duration = duration;
-  const eval::TargetRunResult offline =
-      eval::run_target_on_sim(cfg, options.vio, options.target, options.perturb_seed);
-  REQUIRE_FALSE(offline.diverged);
+  const eval::TargetRunResult offline = check_equals_offline("config/sim_paper_rc_car.yaml", duration, options, m);
   CHECK(offline.target_stats.target_restarts == 1);
-  eval::TrajectoryErrors node_errors;
-  for (const eval::ErrorSample& e : m.target_in_imu) node_errors.add(e);
-  const eval::ErrorSummary node_summary = node_errors.summary();
-  CHECK(offline.target_in_imu.count == node_summary.count);
-  CHECK(offline.target_in_imu.rmse_position_m == Approx(node_summary.rmse_position_m).epsilon(1e-9));
-  CHECK(offline.target_in_imu.nees_position == Approx(node_summary.nees_position).epsilon(1e-9));
-  CHECK((offline.target_frame.p_TestInT - m.target_frame.p_TestInT).norm() < 1e-12);
 }
