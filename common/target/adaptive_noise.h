@@ -64,9 +64,11 @@ struct AdaptiveNoiseOptions {
   double max_step{4.0};     // largest σ² factor of one violating frame
   double hold_s{0.0};       // [s] σ = the largest windowed σ̂ of this long (0: the latest)
   int horizon{1};           // frames whose corrections are summed before squaring (<= window)
-  /// Used by TargetFilter: when the model is first judged consistent after a
-  /// violation, start the target again from its features (its frame was made
-  /// under a σ its own measurements rejected; docs/target_model.md, "The restart").
+  /// Used by TargetFilter: when the model is first judged consistent and its
+  /// σ then exceeds the σ the target was started under by more than one
+  /// violation's largest step (σ² · max_step), start the target again from its
+  /// features (its frame was made under a σ found too small;
+  /// docs/target_model.md, "The restart").
   bool restart{false};
   /// Throws std::invalid_argument naming the bad option.
   void validate() const;

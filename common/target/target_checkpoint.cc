@@ -1,5 +1,6 @@
 #include "common/target/target_checkpoint.h"
 
+#include <cmath>
 #include <map>
 #include <memory>
 #include <optional>
@@ -63,6 +64,7 @@ std::string TargetCheckpoint::save() const {
   w.put(filter_.frame_count());
   w.put(filter_.starts());
   w.put(static_cast<uint8_t>(filter_.model_verified()));
+  w.put(filter_.sigma_at_start());
   w.put(static_cast<int64_t>(filter_.points().size()));
   for (const auto& [id, point] : filter_.points()) {
     w.put(id);
@@ -93,6 +95,7 @@ bool TargetCheckpoint::load(
   const int64_t frame = r.take<int64_t>();
   const int32_t starts = r.take<int32_t>();
   const bool model_verified = r.take<uint8_t>() != 0;
+  const double sigma_at_start = r.take<double>();
   const int64_t n_points = r.take<int64_t>();
   std::map<int64_t, int64_t> last_updated;
   for (int64_t i = 0; r.ok() && i < n_points; ++i) {
@@ -126,12 +129,12 @@ bool TargetCheckpoint::load(
     }
   }
   if (points.size() != last_updated.size() || (!target && (!clones.empty() || !points.empty())) || starts < 0 ||
-      (target && starts == 0)) {
+      (target && starts == 0) || !std::isfinite(sigma_at_start)) {
     *why = "its target variables do not match its bookkeeping";
     return false;
   }
   filter_.restore(std::move(target), std::move(clones), std::move(points), std::move(tracks), frame,
-                  std::move(adaptive), starts, model_verified);
+                  std::move(adaptive), starts, model_verified, sigma_at_start);
   return true;
 }
 

@@ -176,6 +176,7 @@ void TargetFilter::reset() {
   frame_ = 0;
   starts_ = 0;
   model_verified_ = false;
+  sigma_at_start_ = 0.0;
   predicted_.reset();
   if (adaptive_) {
     adaptive_.emplace(options_.adaptive, options_.sigma_t);
@@ -185,7 +186,8 @@ void TargetFilter::reset() {
 
 void TargetFilter::restore(std::shared_ptr<TargetState> target, std::map<int64_t, std::shared_ptr<PoseJPL>> clones,
                            std::map<int64_t, TargetPoint> points, estimator::FeatureDatabase tracks, int64_t frame,
-                           std::optional<AdaptiveNoise> adaptive, int32_t starts, bool model_verified) {
+                           std::optional<AdaptiveNoise> adaptive, int32_t starts, bool model_verified,
+                           double sigma_at_start) {
   reset();
   target_ = std::move(target);
   clones_ = std::move(clones);
@@ -194,6 +196,7 @@ void TargetFilter::restore(std::shared_ptr<TargetState> target, std::map<int64_t
   frame_ = frame;
   starts_ = starts;
   model_verified_ = model_verified;
+  sigma_at_start_ = sigma_at_start;
   if (adaptive_ && adaptive) {
     adaptive_ = std::move(adaptive);
     noise_ = options_.noise(adaptive_->sigma());
@@ -375,6 +378,7 @@ bool TargetFilter::initialize_from_truth(State& state, int64_t utime) {
 void TargetFilter::add_target(State& state, int64_t utime, const TargetValue& x, const Matrix12d& P_TT,
                               const Eigen::MatrixXd& P_Tx) {
   ++starts_;
+  if (adaptive_) sigma_at_start_ = adaptive_->sigma();
   target_ = std::make_shared<TargetState>();
   target_->set_value(x.to_vector());
   target_->set_fej(x.to_vector());
@@ -589,8 +593,12 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
     // measurements rejected: an error made then along its gauge (where its
     // origin sits among its points) no later measurement can see. Now that
     // σ is verified, the target starts again from its features under it.
-    if (options_.adaptive.restart && adaptive_->violations() > 0 &&
-        options_.init_mode == TargetInitMode::kFeatures) {
+    // Too small: more than one violation's largest step (σ² · max_step)
+    // below the σ now verified. A start under a σ too large is kept: it
+    // makes no such error (the risk is one-sided, as for the hold).
+    const double sigma = adaptive_->sigma();
+    const bool started_too_small = sigma * sigma > options_.adaptive.max_step * sigma_at_start_ * sigma_at_start_;
+    if (options_.adaptive.restart && started_too_small && options_.init_mode == TargetInitMode::kFeatures) {
       restart_target(state);
     }
   }

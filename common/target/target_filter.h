@@ -240,6 +240,8 @@ class TargetFilter : public estimator::VioExtension {
   int32_t starts() const { return starts_; }
   /// kAdaptive: whether the model has been judged consistent at least once.
   bool model_verified() const { return model_verified_; }
+  /// kAdaptive: the σ the target was last started under.
+  double sigma_at_start() const { return sigma_at_start_; }
   /// The target variable (nullptr before initialisation).
   const std::shared_ptr<TargetState>& target() const { return target_; }
   const std::map<int64_t, std::shared_ptr<estimator::PoseJPL>>& clones() const { return clones_; }
@@ -264,7 +266,7 @@ class TargetFilter : public estimator::VioExtension {
   /// count and σ_t estimate (kAdaptive); what lives within a frame is cleared.
   void restore(std::shared_ptr<TargetState> target, std::map<int64_t, std::shared_ptr<estimator::PoseJPL>> clones,
                std::map<int64_t, TargetPoint> points, estimator::FeatureDatabase tracks, int64_t frame,
-               std::optional<AdaptiveNoise> adaptive, int32_t starts, bool model_verified);
+               std::optional<AdaptiveNoise> adaptive, int32_t starts, bool model_verified, double sigma_at_start);
   /// Whether target updates now change the robot (kEkf, or kAdaptive judged consistent).
   bool tightly_coupled() const;
 
@@ -345,6 +347,7 @@ class TargetFilter : public estimator::VioExtension {
   int64_t frame_{0};
   int32_t starts_{0};
   bool model_verified_{false};
+  double sigma_at_start_{0.0};
   std::optional<AdaptiveNoise> adaptive_;
   // kAdaptive: driven components' values and covariance after this frame's
   // propagation, and its length (s).

@@ -7,7 +7,7 @@
 // target (docs/evaluation.md), the check trips, σ̂ rises far above the
 // start and the target is kept. The shipped restart (adaptive.restart):
 // the target is started again exactly once, when the model is first judged
-// consistent, and only if a violation came before.
+// consistent, and only if it was started under a σ found too small then.
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -57,7 +57,7 @@ TEST_CASE("adaptive mode: no violation on a right model, tight coupling after th
                  << s.adaptive_sigma_last);
   REQUIRE_FALSE(r.diverged);
   CHECK(s.adaptive_violations == 0);
-  CHECK(s.target_restarts == 0);  // consistent, but no violation before: the start was made under a right σ
+  CHECK(s.target_restarts == 0);  // started under a σ above the one verified: kept
   const int window = target::AdaptiveNoiseOptions{}.window;
   CHECK(s.adaptive_coupled_frames == s.adaptive_frames - (window - 1));
   CHECK(s.adaptive_sigma_last < 0.05);
