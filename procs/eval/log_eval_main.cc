@@ -40,11 +40,12 @@ int run(int argc, const char* const* argv) {
   args.add_flag("own-target-frame",
                 "with --target-channel: the filter started its target from its features (target.init.mode\n"
                 "features), so its target frame is its own: compare through the fixed transform to the true\n"
-                "frame taken at its first target state (printed)");
+                "frame taken at its first target state (printed), and again at the first state of each new\n"
+                "start (its start_count changed: the filter started the target again)");
   args.add_option("target-restart-gap", "SECONDS",
                   "with --own-target-frame: target states more than SECONDS apart mean the filter started its\n"
                   "target again (a respawned process, a reset) in a new frame of its own, taken again at its\n"
-                  "first state after the gap (default: taken once)");
+                  "first state after the gap (default: only where start_count changes)");
   args.add_option("from-utime", "UTIME",
                   "evaluate only the states (and target states) at or after this utime, e.g. those of a\n"
                   "process restarted mid-run (its \"initialised from ground truth at utime N\")");
