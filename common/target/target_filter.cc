@@ -589,13 +589,13 @@ void TargetFilter::update(State& state, int64_t utime, const std::vector<Feature
   end_adaptive_frame(state);
   if (adaptive_ && !model_verified_ && adaptive_->consistent()) {
     model_verified_ = true;
-    // The target's frame and points were made under a σ that its own
-    // measurements rejected: an error made then along its gauge (where its
-    // origin sits among its points) no later measurement can see. Now that
-    // σ is verified, the target starts again from its features under it.
-    // Too small: more than one violation's largest step (σ² · max_step)
-    // below the σ now verified. A start under a σ too large is kept: it
-    // makes no such error (the risk is one-sided, as for the hold).
+    // A target started under a σ too small has made its frame and points
+    // under it: an error made then along its gauge (where its origin sits
+    // among its points) no later measurement can see. So it starts again
+    // from its features under the σ now verified. Too small: more than one
+    // violation's largest step (σ² · max_step) below that σ. A start under
+    // a σ too large is kept: it makes no such error (the risk is one-sided,
+    // as for the hold).
     const double sigma = adaptive_->sigma();
     const bool started_too_small = sigma * sigma > options_.adaptive.max_step * sigma_at_start_ * sigma_at_start_;
     if (options_.adaptive.restart && started_too_small && options_.init_mode == TargetInitMode::kFeatures) {
