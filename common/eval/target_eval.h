@@ -62,8 +62,9 @@ struct TargetRunResult {
   ErrorSummary target_in_world;  // [q_GtoT, p_TinG]
   ErrorSummary imu;              // [q_GtoI, p_IinG]
   bool target_initialized{false};
-  /// The filter's target frame in the true one, fixed at its first estimate
-  /// (init mode features); identity for the start from the truth.
+  /// The filter's target frame in the true one, taken at its first estimate
+  /// and again at the first estimate of each new start (init mode features;
+  /// the last one taken); identity for the start from the truth.
   TargetFrameTransform target_frame;
   int64_t frames_processed{0};
   /// Whether the target was tracked through the run, counted over the

@@ -214,7 +214,9 @@ int run(int argc, const char* const* argv) {
                     100.0 * static_cast<double>(r.frames_with_target_update) / n,
                     static_cast<long long>(r.longest_gap_frames), r.target_max_error_m);
         if (base_filter.init_mode == target::TargetInitMode::kFeatures) {
-          std::cout << "    filter's target frame in the true one " << r.target_frame.describe() << "\n";
+          std::cout << "    filter's target frame in the true one"
+                    << (r.target_stats.target_restarts > 0 ? " (after its restart) " : " ") << r.target_frame.describe()
+                    << "\n";
         }
       }
     }
